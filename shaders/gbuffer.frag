@@ -1,0 +1,23 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// G-buffer from the camera (ALGORITHM.md section 3, step 1).
+#include "shared.glsl"
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(push_constant) uniform Push { DrawPush draw; };
+#include "material.glsl"
+
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+
+layout(location = 0) out vec4 out_position;  // xyz: world (m); w: view depth (m), 0 = background
+layout(location = 1) out vec4 out_normal;    // xyz: unit world normal facing the camera
+layout(location = 2) out vec4 out_albedo;    // rgb: linear diffuse albedo
+
+void main() {
+    float view_depth = dot(in_world - u.camera_position.xyz, u.camera_forward.xyz);
+    out_position = vec4(in_world, max(view_depth, 1e-6));
+    out_normal = vec4(facing_normal(in_normal), 0.0);
+    out_albedo = vec4(material_albedo(draw.material, in_uv), 1.0);
+}

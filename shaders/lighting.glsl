@@ -1,0 +1,23 @@
+// Spot light radiometry (ALGORITHM.md section 2) shared by the RSM and direct passes.
+#ifndef LIGHTING_GLSL
+#define LIGHTING_GLSL
+
+const float PI = 3.14159265358979323846;
+
+// Radiant intensity (W/sr) of the spot light toward world point p, per channel:
+// KHR_lights_punctual angular attenuation (squared smooth ramp between the
+// cones) and, when a range is set, the extension's range window.
+vec3 spot_intensity(FrameUniforms u, vec3 p) {
+    vec3 to_p = p - u.light_position.xyz;
+    float d = length(to_p);
+    float cd = dot(u.light_direction.xyz, to_p / max(d, 1e-20));
+    float t = clamp(cd * u.light_cone.x + u.light_cone.y, 0.0, 1.0);
+    vec3 i = u.light_intensity.rgb * (t * t);
+    if (u.light_position.w > 0.0) {
+        float r = d / u.light_position.w;
+        i *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    }
+    return i;
+}
+
+#endif

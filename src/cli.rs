@@ -1,0 +1,200 @@
+//! The `isr` command line: argument parsing and the `render`, `devices` and
+//! `export-builtin` commands. `main.rs` only calls [`run`].
+
+use crate::renderer::{Method, RenderSettings, Renderer};
+use crate::vk::{Gpu, GpuOptions, Validation};
+use crate::{output, report, scene};
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "isr",
+    version,
+    about = "Hierarchical image-space radiosity and its baselines, on Vulkan"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene headless and write EXR, PNG and per-pass GPU timings.
+    Render(RenderArgs),
+    /// List the Vulkan devices (the index is what --device takes).
+    Devices,
+    /// Write the built-in Cornell box as a glTF file.
+    ExportBuiltin {
+        /// Output .gltf path.
+        path: PathBuf,
+    },
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// How indirect light is computed.
+    #[arg(long, value_enum, default_value_t = Method::None)]
+    method: Method,
+    /// Output width in pixels.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Output height in pixels.
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Reflective shadow map resolution R (R x R, a power of two).
+    #[arg(long, default_value_t = 512)]
+    rsm: u32,
+    /// Frames to render; timings are medians over them.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    frames: u32,
+    /// Multi-layer OpenEXR output (linear).
+    #[arg(long, default_value = "out/render.exr")]
+    out: PathBuf,
+    /// PNG output (tonemapped sRGB).
+    #[arg(long, default_value = "out/render.png")]
+    png: PathBuf,
+    /// Write per-pass GPU timings as JSON to this file.
+    #[arg(long)]
+    timings: Option<PathBuf>,
+    /// Multiplier on radiance before the PNG's sRGB encoding.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Load the Khronos validation layer with synchronization validation; exit
+    /// non-zero if it reports anything.
+    #[arg(long)]
+    validate: bool,
+    /// Device index from `isr devices` (default: discrete > integrated > virtual > CPU).
+    #[arg(long)]
+    device: Option<usize>,
+}
+
+/// Parses `std::env::args` and runs the command.
+pub fn run() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Render(args) => render(args),
+        Command::Devices => devices(),
+        Command::ExportBuiltin { path } => {
+            let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;
+            std::fs::write(&path, json)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            println!("wrote {}", path.display());
+            Ok(())
+        }
+    }
+}
+
+fn devices() -> Result<()> {
+    let list = crate::vk::context::list_devices()?;
+    if list.is_empty() {
+        bail!(
+            "no Vulkan device found; {}",
+            crate::vk::context::INSTALL_DRIVER_HINT
+        );
+    }
+    for d in list {
+        let (ma, mi, pa) = d.api_version;
+        println!(
+            "{}: {} [{}] driver {} Vulkan {ma}.{mi}.{pa}{}",
+            d.index,
+            d.name,
+            d.kind_name(),
+            d.driver,
+            d.unusable
+                .map(|w| format!(" (unusable: {w})"))
+                .unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => scene::gltf_load::load(path)?,
+        None => scene::cornell::cornell_box(),
+    };
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    if scene.light.outer_cone > crate::renderer::MAX_RSM_HALF_FOV {
+        eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");
+    }
+    let gpu = Gpu::new(&GpuOptions {
+        validation: if args.validate {
+            Validation::Required
+        } else {
+            Validation::Off
+        },
+        device_index: args.device,
+    })?;
+    let settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        rsm_resolution: args.rsm,
+        method: args.method,
+        exposure: args.exposure,
+        ..RenderSettings::default()
+    };
+    eprintln!(
+        "rendering {} ({} triangles) at {}x{}, rsm {}, method {} on {}",
+        scene.name,
+        scene.triangle_count(),
+        args.width,
+        args.height,
+        args.rsm,
+        args.method.name(),
+        gpu.info.name
+    );
+    let mut renderer = Renderer::new(&gpu, &scene, &settings)?;
+    let frames = args.frames;
+    let stats = renderer.render_frames(frames, |i| {
+        if frames > 1 {
+            eprint!("\rframe {i}/{frames}");
+            if i == frames {
+                eprintln!();
+            }
+        }
+    })?;
+    let result = renderer.readback()?;
+    drop(renderer);
+
+    let r = report::build(
+        &report::RunInfo {
+            device: &gpu.info.name,
+            driver: &gpu.info.driver,
+            scene: &scene.name,
+            width: args.width,
+            height: args.height,
+            rsm: args.rsm,
+            method: args.method.name(),
+        },
+        &stats,
+    );
+    print!("{}", report::table(&r));
+    if let Some(path) = &args.timings {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+        }
+        std::fs::write(path, serde_json::to_string_pretty(&r)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    output::write_exr(&args.out, &result)?;
+    output::write_png(&args.png, result.width, result.height, &result.display)?;
+    println!("wrote {} and {}", args.out.display(), args.png.display());
+
+    let messages = gpu.take_validation_messages();
+    if !messages.is_empty() {
+        bail!(
+            "the validation layer reported {} message(s) (printed above)",
+            messages.len()
+        );
+    }
+    Ok(())
+}

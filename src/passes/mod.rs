@@ -1,0 +1,283 @@
+//! The passes of one frame, one module each. Every pass records, in one place,
+//! its timing scope, its barriers and its draws:
+//!
+//! 1. [`rsm`]: reflective shadow map from the spot light.
+//! 2. [`gbuffer`]: depth, position, normal, albedo from the camera.
+//! 3. [`direct_light`]: direct radiance, RSM depth as the shadow map.
+//! 4. (indirect methods, later issues: they write `Targets::indirect`)
+//! 5. [`composite`]: direct + albedo/pi * indirect irradiance.
+//! 6. [`tonemap`]: sRGB display image for the PNG.
+//!
+//! Barrier convention (see `vk::barrier`): a pass transitions its outputs from
+//! "discard, after earlier readers" to attachment use, and at its end leaves
+//! them in `SHADER_READ_ONLY_OPTIMAL`, visible to every later reader.
+
+pub mod composite;
+pub mod direct_light;
+pub mod gbuffer;
+pub mod rsm;
+pub mod tonemap;
+
+use crate::gpu_types::{bytes_of, DrawPush};
+use crate::renderer::SceneGpu;
+use crate::vk::barrier::{self, Use};
+use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, Pipeline};
+use crate::vk::profiler::PassKind;
+use crate::vk::{Gpu, Image};
+use anyhow::Result;
+use ash::vk;
+
+pub const GRAPHICS: PassKind = PassKind {
+    graphics: true,
+    indirect: false,
+};
+
+/// Starts dynamic rendering into `colors` (cleared to zero) and `depth`
+/// (cleared to 0, the far plane of reversed-Z), and sets viewport and scissor
+/// to the attachments' extent.
+pub fn begin_rendering(
+    gpu: &Gpu,
+    cmd: vk::CommandBuffer,
+    colors: &[&Image],
+    depth: Option<&Image>,
+) {
+    let extent = colors.first().or(depth.as_ref()).map(|i| i.extent).unwrap();
+    let color_attachments: Vec<_> = colors
+        .iter()
+        .map(|img| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [0.0; 4] },
+                })
+        })
+        .collect();
+    let depth_attachment = depth.map(|d| {
+        vk::RenderingAttachmentInfo::default()
+            .image_view(d.view)
+            .image_layout(vk::ImageLayout::ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            })
+    });
+    let area = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    };
+    let mut info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1)
+        .color_attachments(&color_attachments);
+    if let Some(d) = &depth_attachment {
+        info = info.depth_attachment(d);
+    }
+    unsafe {
+        gpu.device.cmd_begin_rendering(cmd, &info);
+        gpu.device.cmd_set_viewport(
+            cmd,
+            0,
+            &[vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: extent.width as f32,
+                height: extent.height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            }],
+        );
+        gpu.device.cmd_set_scissor(cmd, 0, &[area]);
+    }
+}
+
+/// A pass that rasterizes the scene's meshes (RSM and G-buffer): color targets
+/// plus a reversed-Z depth buffer, one draw per mesh instance.
+pub struct ScenePass {
+    pipeline: Pipeline,
+}
+
+impl ScenePass {
+    pub fn new(
+        gpu: &Gpu,
+        name: &str,
+        fragment_shader: &str,
+        scene: &SceneGpu,
+        color_formats: &[vk::Format],
+        from_light: bool,
+    ) -> Result<Self> {
+        let pipeline = Pipeline::graphics(
+            gpu,
+            &GraphicsDesc {
+                name,
+                vertex_shader: "scene.vert",
+                fragment_shader,
+                set_layouts: &[scene.set.layout],
+                push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+                scene_vertices: true,
+                color_formats,
+                depth_format: vk::Format::D32_SFLOAT,
+                depth_test: Some(vk::CompareOp::GREATER),
+                dynamic_cull: true,
+                specialization: &[(0, scene.texture_count() as i32), (1, from_light as i32)],
+            },
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// Clears and fills `colors` and `depth` with the scene, with the barriers
+    /// of the convention above on both sides.
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        scene: &SceneGpu,
+        colors: &[&Image],
+        depth: &Image,
+    ) {
+        let mut before: Vec<_> = colors
+            .iter()
+            .map(|c| barrier::image(c, Use::DISCARD_AFTER_READERS, Use::COLOR_ATTACHMENT))
+            .collect();
+        before.push(barrier::image(
+            depth,
+            Use::DISCARD_AFTER_READERS,
+            Use::DEPTH_ATTACHMENT,
+        ));
+        barrier::images(gpu, cmd, &before);
+
+        begin_rendering(gpu, cmd, colors, Some(depth));
+        let d = &gpu.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline.layout,
+                0,
+                &[scene.set.set],
+                &[],
+            );
+            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+            d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+            for draw in &scene.draws {
+                let cull = if draw.double_sided {
+                    vk::CullModeFlags::NONE
+                } else {
+                    vk::CullModeFlags::BACK
+                };
+                d.cmd_set_cull_mode(cmd, cull);
+                d.cmd_set_front_face(cmd, crate::vk::pipeline::FRONT_FACE);
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline.layout,
+                    vk::ShaderStageFlags::ALL_GRAPHICS,
+                    0,
+                    bytes_of(&draw.push),
+                );
+                d.cmd_draw_indexed(
+                    cmd,
+                    draw.index_count,
+                    1,
+                    draw.first_index,
+                    draw.vertex_offset,
+                    0,
+                );
+            }
+            d.cmd_end_rendering(cmd);
+        }
+
+        let mut after: Vec<_> = colors
+            .iter()
+            .map(|c| barrier::image(c, Use::COLOR_ATTACHMENT, Use::READ_ONLY))
+            .collect();
+        after.push(barrier::image(depth, Use::DEPTH_ATTACHMENT, Use::READ_ONLY));
+        barrier::images(gpu, cmd, &after);
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+    }
+}
+
+/// A pass that runs one fragment shader over every pixel of its outputs,
+/// reading its inputs with `texelFetch` (binding 0 is always the frame uniforms).
+pub struct FullscreenPass {
+    pipeline: Pipeline,
+    set: DescriptorSet,
+}
+
+impl FullscreenPass {
+    pub fn new(
+        gpu: &Gpu,
+        name: &str,
+        fragment_shader: &str,
+        bindings: &[Binding],
+        color_formats: &[vk::Format],
+    ) -> Result<Self> {
+        let set = DescriptorSet::new(gpu, name, bindings)?;
+        let pipeline = Pipeline::graphics(
+            gpu,
+            &GraphicsDesc {
+                name,
+                vertex_shader: "fullscreen.vert",
+                fragment_shader,
+                set_layouts: &[set.layout],
+                push_constant_bytes: 0,
+                scene_vertices: false,
+                color_formats,
+                depth_format: vk::Format::UNDEFINED,
+                depth_test: None,
+                dynamic_cull: false,
+                specialization: &[],
+            },
+        )?;
+        Ok(Self { pipeline, set })
+    }
+
+    /// Writes every pixel of `outputs`, with the convention's barriers.
+    pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer, outputs: &[&Image]) {
+        barrier::transition(
+            gpu,
+            cmd,
+            outputs,
+            Use::DISCARD_AFTER_READERS,
+            Use::COLOR_ATTACHMENT,
+        );
+        begin_rendering(gpu, cmd, outputs, None);
+        let d = &gpu.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline.layout,
+                0,
+                &[self.set.set],
+                &[],
+            );
+            d.cmd_draw(cmd, 3, 1, 0, 0);
+            d.cmd_end_rendering(cmd);
+        }
+        barrier::transition(gpu, cmd, outputs, Use::COLOR_ATTACHMENT, Use::READ_ONLY);
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.set.destroy(gpu);
+    }
+}
+
+/// Everything a pass may need while recording a frame.
+pub struct FrameContext<'a> {
+    pub gpu: &'a Gpu,
+    pub cmd: vk::CommandBuffer,
+    pub scene: &'a SceneGpu,
+    pub targets: &'a crate::renderer::Targets,
+}

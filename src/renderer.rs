@@ -1,0 +1,869 @@
+//! One frame of `isr`: scene upload, render targets, the passes in order, GPU
+//! timing of each, and readback of the results.
+
+use crate::gpu_types::{bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
+use crate::passes::{
+    composite::CompositePass, direct_light::DirectLightPass, gbuffer::GBufferPass, rsm::RsmPass,
+    tonemap::TonemapPass, FrameContext,
+};
+use crate::scene::{GpuVertex, Scene};
+use crate::vk::barrier::{self, Use};
+use crate::vk::pipeline::{Binding, DescriptorSet};
+use crate::vk::profiler::{PassSample, Profiler};
+use crate::vk::resources::texel_bytes;
+use crate::vk::{Buffer, Gpu, Image, ImageDesc};
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+use glam::{Mat4, Vec3};
+use gpu_allocator::MemoryLocation;
+use std::time::Instant;
+
+/// How indirect light is computed. Later issues add the image-space methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// Direct light only: indirect irradiance is zero.
+    None,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::None => "none",
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// RSM resolution R (R x R texels), a power of two.
+    pub rsm_resolution: u32,
+    pub method: Method,
+    /// Multiplier applied to radiance before the PNG's sRGB encoding.
+    pub exposure: f32,
+    /// Shadow-map normal offset, in RSM texels at the receiver.
+    pub shadow_normal_offset: f32,
+    /// Constant relative depth bias of the shadow test (fraction of the distance).
+    pub shadow_depth_bias: f32,
+    /// PCF tap spacing in RSM texels.
+    pub pcf_radius: f32,
+    /// Slope-scaled shadow bias, in RSM texels along the receiver's slope.
+    pub shadow_slope_bias: f32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            rsm_resolution: 512,
+            method: Method::None,
+            exposure: 1.0,
+            shadow_normal_offset: 1.5,
+            shadow_depth_bias: 5e-4,
+            pcf_radius: 1.0,
+            shadow_slope_bias: 2.5,
+        }
+    }
+}
+
+/// Every image a frame writes. Each is written by exactly one pass.
+pub struct Targets {
+    pub rsm_position: Image,
+    pub rsm_normal: Image,
+    pub rsm_flux: Image,
+    pub rsm_depth: Image,
+    pub gbuffer_position: Image,
+    pub gbuffer_normal: Image,
+    pub gbuffer_albedo: Image,
+    pub gbuffer_depth: Image,
+    pub direct: Image,
+    /// Indirect irradiance E (W/m^2) at full resolution, written by the method.
+    pub indirect: Image,
+    pub final_radiance: Image,
+    pub display: Image,
+}
+
+const COLOR_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
+    vk::ImageUsageFlags::COLOR_ATTACHMENT.as_raw()
+        | vk::ImageUsageFlags::SAMPLED.as_raw()
+        | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
+);
+const DEPTH_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
+    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
+);
+
+/// (name, format, at RSM resolution, usage) of every target, in `Targets` order.
+fn target_list(s: &RenderSettings) -> Vec<(&'static str, vk::Format, bool, vk::ImageUsageFlags)> {
+    use crate::passes::*;
+    let _ = s;
+    vec![
+        ("rsm_position", rsm::FORMATS[0], true, COLOR_USAGE),
+        ("rsm_normal", rsm::FORMATS[1], true, COLOR_USAGE),
+        ("rsm_flux", rsm::FORMATS[2], true, COLOR_USAGE),
+        ("rsm_depth", vk::Format::D32_SFLOAT, true, DEPTH_USAGE),
+        ("gbuffer_position", gbuffer::FORMATS[0], false, COLOR_USAGE),
+        ("gbuffer_normal", gbuffer::FORMATS[1], false, COLOR_USAGE),
+        ("gbuffer_albedo", gbuffer::FORMATS[2], false, COLOR_USAGE),
+        ("gbuffer_depth", vk::Format::D32_SFLOAT, false, DEPTH_USAGE),
+        ("direct", direct_light::FORMAT, false, COLOR_USAGE),
+        (
+            "indirect",
+            vk::Format::R32G32B32A32_SFLOAT,
+            false,
+            vk::ImageUsageFlags::from_raw(
+                COLOR_USAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_DST.as_raw(),
+            ),
+        ),
+        ("final", composite::FORMAT, false, COLOR_USAGE),
+        ("display", tonemap::FORMAT, false, COLOR_USAGE),
+    ]
+}
+
+impl Targets {
+    fn new(gpu: &Gpu, s: &RenderSettings) -> Result<Self> {
+        let mut images = Vec::new();
+        for (name, format, rsm, usage) in target_list(s) {
+            let extent = if rsm {
+                vk::Extent2D {
+                    width: s.rsm_resolution,
+                    height: s.rsm_resolution,
+                }
+            } else {
+                vk::Extent2D {
+                    width: s.width,
+                    height: s.height,
+                }
+            };
+            match Image::new(
+                gpu,
+                &ImageDesc {
+                    name,
+                    format,
+                    extent,
+                    layers: 1,
+                    usage,
+                },
+            ) {
+                Ok(i) => images.push(i),
+                Err(e) => {
+                    for mut i in images {
+                        i.destroy(gpu);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let mut it = images.into_iter();
+        let mut next = || it.next().unwrap();
+        Ok(Self {
+            rsm_position: next(),
+            rsm_normal: next(),
+            rsm_flux: next(),
+            rsm_depth: next(),
+            gbuffer_position: next(),
+            gbuffer_normal: next(),
+            gbuffer_albedo: next(),
+            gbuffer_depth: next(),
+            direct: next(),
+            indirect: next(),
+            final_radiance: next(),
+            display: next(),
+        })
+    }
+
+    fn all_mut(&mut self) -> [&mut Image; 12] {
+        [
+            &mut self.rsm_position,
+            &mut self.rsm_normal,
+            &mut self.rsm_flux,
+            &mut self.rsm_depth,
+            &mut self.gbuffer_position,
+            &mut self.gbuffer_normal,
+            &mut self.gbuffer_albedo,
+            &mut self.gbuffer_depth,
+            &mut self.direct,
+            &mut self.indirect,
+            &mut self.final_radiance,
+            &mut self.display,
+        ]
+    }
+}
+
+pub struct Samplers {
+    /// For `texelFetch` inputs (a combined image sampler needs some sampler).
+    pub nearest: vk::Sampler,
+    /// Hardware 2x2 PCF on reversed-Z depth: passes where reference >= stored.
+    pub shadow: vk::Sampler,
+    /// Scene textures: bilinear, repeat.
+    pub texture: vk::Sampler,
+}
+
+impl Samplers {
+    fn new(gpu: &Gpu) -> Result<Self> {
+        let base = vk::SamplerCreateInfo::default()
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0);
+        let d = &gpu.device;
+        unsafe {
+            Ok(Self {
+                nearest: d.create_sampler(&base, None)?,
+                shadow: d.create_sampler(
+                    &base
+                        .mag_filter(vk::Filter::LINEAR)
+                        .min_filter(vk::Filter::LINEAR)
+                        .compare_enable(true)
+                        .compare_op(vk::CompareOp::GREATER_OR_EQUAL),
+                    None,
+                )?,
+                texture: d.create_sampler(
+                    &base
+                        .mag_filter(vk::Filter::LINEAR)
+                        .min_filter(vk::Filter::LINEAR)
+                        .address_mode_u(vk::SamplerAddressMode::REPEAT)
+                        .address_mode_v(vk::SamplerAddressMode::REPEAT),
+                    None,
+                )?,
+            })
+        }
+    }
+
+    fn destroy(&self, gpu: &Gpu) {
+        unsafe {
+            gpu.device.destroy_sampler(self.nearest, None);
+            gpu.device.destroy_sampler(self.shadow, None);
+            gpu.device.destroy_sampler(self.texture, None);
+        }
+    }
+}
+
+/// One indexed draw of a mesh instance.
+pub struct Draw {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub vertex_offset: i32,
+    pub double_sided: bool,
+    pub push: DrawPush,
+}
+
+/// The scene on the GPU: one vertex and one index buffer for all meshes, the
+/// materials, the textures, and the descriptor set the scene passes share
+/// (binding 0: frame uniforms, 1: materials, 2: textures).
+pub struct SceneGpu {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub materials: Buffer,
+    /// At least one (a white texel when the scene has no textures).
+    pub textures: Vec<Image>,
+    pub draws: Vec<Draw>,
+    pub set: DescriptorSet,
+}
+
+impl SceneGpu {
+    fn new(gpu: &Gpu, scene: &Scene, uniforms: &Buffer, sampler: vk::Sampler) -> Result<Self> {
+        let mut vertices: Vec<GpuVertex> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut ranges = Vec::new();
+        for mesh in &scene.meshes {
+            ranges.push((
+                indices.len() as u32,
+                mesh.indices.len() as u32,
+                vertices.len() as i32,
+            ));
+            vertices.extend_from_slice(&mesh.vertices);
+            indices.extend_from_slice(&mesh.indices);
+        }
+        let draws = scene
+            .instances
+            .iter()
+            .map(|inst| {
+                let mesh = &scene.meshes[inst.mesh];
+                let (first_index, index_count, vertex_offset) = ranges[inst.mesh];
+                Draw {
+                    first_index,
+                    index_count,
+                    vertex_offset,
+                    double_sided: scene.materials[mesh.material].double_sided,
+                    push: DrawPush {
+                        world_from_object: inst.world_from_object.to_cols_array_2d(),
+                        material: mesh.material as u32,
+                        pad: [0; 3],
+                    },
+                }
+            })
+            .collect();
+        let materials: Vec<MaterialGpu> = scene
+            .materials
+            .iter()
+            .map(|m| MaterialGpu {
+                base_color: m.base_color.to_array(),
+                texture: m.texture.map_or(-1, |t| t as i32),
+                pad: [0; 3],
+            })
+            .collect();
+        let limit = gpu
+            .limits()
+            .max_per_stage_descriptor_sampled_images
+            .min(gpu.limits().max_per_stage_descriptor_samplers) as usize;
+        if scene.textures.len() > limit.saturating_sub(8) {
+            bail!(
+                "the scene has {} textures; this device allows {} sampled images per shader stage",
+                scene.textures.len(),
+                limit
+            );
+        }
+        let white = crate::scene::Texture {
+            name: "white".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![255; 4],
+        };
+        let sources: Vec<&crate::scene::Texture> = if scene.textures.is_empty() {
+            vec![&white]
+        } else {
+            scene.textures.iter().collect()
+        };
+        let mut textures = Vec::new();
+        for t in sources {
+            textures.push(upload_texture(gpu, t)?);
+        }
+        let vertices = Buffer::with_data(
+            gpu,
+            "vertices",
+            slice_bytes(&vertices),
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+        )?;
+        let indices = Buffer::with_data(
+            gpu,
+            "indices",
+            slice_bytes(&indices),
+            vk::BufferUsageFlags::INDEX_BUFFER,
+        )?;
+        let materials = Buffer::with_data(
+            gpu,
+            "materials",
+            slice_bytes(&materials),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let views: Vec<vk::ImageView> = textures.iter().map(|t| t.view).collect();
+        let set = DescriptorSet::new(
+            gpu,
+            "scene",
+            &[
+                Binding::Uniform(uniforms),
+                Binding::Storage(&materials),
+                Binding::SampledArray(&views, sampler),
+            ],
+        )?;
+        Ok(Self {
+            vertices,
+            indices,
+            materials,
+            textures,
+            draws,
+            set,
+        })
+    }
+
+    pub fn texture_count(&self) -> usize {
+        self.textures.len()
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.vertices.destroy(gpu);
+        self.indices.destroy(gpu);
+        self.materials.destroy(gpu);
+        for t in &mut self.textures {
+            t.destroy(gpu);
+        }
+        self.set.destroy(gpu);
+    }
+}
+
+fn upload_texture(gpu: &Gpu, t: &crate::scene::Texture) -> Result<Image> {
+    let max = gpu.limits().max_image_dimension2_d;
+    if t.width > max || t.height > max {
+        bail!(
+            "texture {} is {}x{}; this device allows at most {max}",
+            t.name,
+            t.width,
+            t.height
+        );
+    }
+    let image = Image::new(
+        gpu,
+        &ImageDesc {
+            name: &t.name,
+            format: vk::Format::R8G8B8A8_SRGB,
+            extent: vk::Extent2D {
+                width: t.width,
+                height: t.height,
+            },
+            layers: 1,
+            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        },
+    )?;
+    let mut staging = Buffer::new(
+        gpu,
+        "texture staging",
+        t.rgba8.len() as u64,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+        MemoryLocation::CpuToGpu,
+    )?;
+    staging.write(0, &t.rgba8);
+    let result = gpu.run_once(|cmd| unsafe {
+        barrier::transition(
+            gpu,
+            cmd,
+            &[&image],
+            Use::DISCARD_AFTER_READERS,
+            Use::TRANSFER_DST,
+        );
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D {
+                width: t.width,
+                height: t.height,
+                depth: 1,
+            });
+        gpu.device.cmd_copy_buffer_to_image(
+            cmd,
+            staging.buffer,
+            image.image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        );
+        barrier::transition(gpu, cmd, &[&image], Use::TRANSFER_DST, Use::READ_ONLY);
+    });
+    staging.destroy(gpu);
+    result.map(|_| image)
+}
+
+/// GPU numbers of every frame rendered, and the CPU-measured wall time of each
+/// (submit to fence).
+#[derive(Clone, Debug, Default)]
+pub struct FrameStats {
+    pub frames: Vec<Vec<PassSample>>,
+    pub wall_ms: Vec<f64>,
+}
+
+/// Image contents copied back to the host, rows top to bottom, RGBA f32.
+pub struct Readback {
+    pub width: u32,
+    pub height: u32,
+    pub final_radiance: Vec<[f32; 4]>,
+    pub direct: Vec<[f32; 4]>,
+    pub indirect: Vec<[f32; 4]>,
+    pub albedo: Vec<[f32; 4]>,
+    pub normal: Vec<[f32; 4]>,
+    /// xyz world position, w view depth (0 for background).
+    pub position: Vec<[f32; 4]>,
+    /// The tonemapped 8-bit sRGB image.
+    pub display: Vec<u8>,
+    pub rsm: RsmReadback,
+}
+
+pub struct RsmReadback {
+    pub resolution: u32,
+    /// xyz position, w 1 where geometry was seen.
+    pub position: Vec<[f32; 4]>,
+    /// xyz normal, w area A_j.
+    pub normal: Vec<[f32; 4]>,
+    /// rgb flux Phi_j, a solid angle dw_j.
+    pub flux: Vec<[f32; 4]>,
+}
+
+pub struct Renderer<'g> {
+    gpu: &'g Gpu,
+    pub settings: RenderSettings,
+    pub scene: SceneGpu,
+    pub targets: Targets,
+    samplers: Samplers,
+    uniforms: Buffer,
+    frame_uniforms: FrameUniforms,
+    rsm: RsmPass,
+    gbuffer: GBufferPass,
+    direct: DirectLightPass,
+    composite: CompositePass,
+    tonemap: TonemapPass,
+    profiler: Profiler,
+    frame_cmd: vk::CommandBuffer,
+}
+
+/// Passes a frame can hold; the profiler's query pools are this large.
+const MAX_PASSES: u32 = 32;
+
+/// Checks `settings` against the device and returns an error that says what to change.
+pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
+    let l = gpu.limits();
+    let max_w = l.max_image_dimension2_d.min(l.max_framebuffer_width);
+    let max_h = l.max_image_dimension2_d.min(l.max_framebuffer_height);
+    if s.width == 0 || s.height == 0 {
+        bail!(
+            "resolution {}x{} is empty: width and height must be at least 1",
+            s.width,
+            s.height
+        );
+    }
+    if s.width > max_w || s.height > max_h {
+        bail!(
+            "resolution {}x{} exceeds what {} can render ({max_w}x{max_h}); choose a smaller --width/--height",
+            s.width,
+            s.height,
+            gpu.info.name
+        );
+    }
+    let r = s.rsm_resolution;
+    if !r.is_power_of_two() || r < 16 {
+        bail!("--rsm {r}: the RSM resolution must be a power of two of at least 16 (it is the root of a quadtree)");
+    }
+    if r > max_w.min(max_h) {
+        bail!(
+            "--rsm {r} exceeds this device's image limit of {}",
+            max_w.min(max_h)
+        );
+    }
+    let needed: u64 = target_list(s)
+        .iter()
+        .map(|(_, f, rsm, _)| {
+            let texels = if *rsm { (r as u64).pow(2) } else { s.width as u64 * s.height as u64 };
+            texels * texel_bytes(*f)
+        })
+        .sum::<u64>()
+        // readback buffers for the largest layers
+        + s.width as u64 * s.height as u64 * 16 * 2;
+    let props = unsafe {
+        gpu.instance
+            .get_physical_device_memory_properties(gpu.physical)
+    };
+    let heap = props.memory_heaps[..props.memory_heap_count as usize]
+        .iter()
+        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+        .unwrap_or(0);
+    if heap > 0 && needed > heap / 10 * 9 {
+        bail!(
+            "resolution {}x{} with --rsm {r} needs about {} MiB of GPU memory; the device has {} MiB. Choose a smaller resolution",
+            s.width,
+            s.height,
+            needed >> 20,
+            heap >> 20
+        );
+    }
+    if !(s.exposure.is_finite() && s.exposure >= 0.0) {
+        bail!("--exposure must be a finite non-negative number");
+    }
+    Ok(())
+}
+
+/// World -> clip for Vulkan: y flipped (framebuffer y points down), reversed-Z
+/// with an infinite far plane (depth 1 at `near`, 0 at infinity).
+fn projection(fov_y: f32, aspect: f32, near: f32) -> Mat4 {
+    Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0))
+        * Mat4::perspective_infinite_reverse_rh(fov_y, aspect, near)
+}
+
+/// The largest RSM half field of view; wider cones are cut (a warning says so).
+pub const MAX_RSM_HALF_FOV: f32 = 80.0 * std::f32::consts::PI / 180.0;
+
+pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
+    let cam = &scene.camera;
+    let view = cam.world_from_camera.inverse();
+    let camera_view_proj = projection(cam.yfov, s.width as f32 / s.height as f32, cam.znear) * view;
+    let l = &scene.light;
+    let up = if l.direction.dot(Vec3::Y).abs() > 0.99 {
+        Vec3::X
+    } else {
+        Vec3::Y
+    };
+    let light_view = Mat4::look_at_rh(l.position, l.position + l.direction, up);
+    let half_fov = l.outer_cone.min(MAX_RSM_HALF_FOV);
+    let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
+    let light_near = (extent * 1e-4).max(1e-6);
+    let light_view_proj = projection(2.0 * half_fov, 1.0, light_near) * light_view;
+    let (scale, offset) = l.cone_scale_offset();
+    let r = s.rsm_resolution as f32;
+    FrameUniforms {
+        camera_view_proj: camera_view_proj.to_cols_array_2d(),
+        light_view_proj: light_view_proj.to_cols_array_2d(),
+        camera_position: cam.position().extend(1.0).to_array(),
+        camera_forward: cam.forward().extend(0.0).to_array(),
+        light_position: l.position.extend(l.range.unwrap_or(0.0)).to_array(),
+        light_direction: l.direction.extend(0.0).to_array(),
+        light_intensity: (l.color * l.intensity).extend(0.0).to_array(),
+        light_cone: [scale, offset, half_fov.tan(), r],
+        shadow: [
+            s.shadow_normal_offset,
+            s.shadow_depth_bias,
+            s.pcf_radius,
+            s.shadow_slope_bias,
+        ],
+        exposure: [s.exposure, 0.0, 0.0, 0.0],
+        size: [s.width, s.height, s.rsm_resolution, 0],
+    }
+}
+
+impl<'g> Renderer<'g> {
+    pub fn new(gpu: &'g Gpu, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
+        check_settings(gpu, settings)?;
+        let frame_uniforms = frame_uniforms(scene, settings);
+        let mut uniforms = Buffer::new(
+            gpu,
+            "frame uniforms",
+            std::mem::size_of::<FrameUniforms>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        uniforms.write(0, bytes_of(&frame_uniforms));
+        let samplers = Samplers::new(gpu)?;
+        let scene_gpu = SceneGpu::new(gpu, scene, &uniforms, samplers.texture)
+            .context("uploading the scene")?;
+        let targets = Targets::new(gpu, settings)?;
+        let rsm = RsmPass::new(gpu, &scene_gpu)?;
+        let gbuffer = GBufferPass::new(gpu, &scene_gpu)?;
+        let direct = DirectLightPass::new(gpu, &uniforms, &targets, &samplers)?;
+        let composite = CompositePass::new(gpu, &uniforms, &targets, &samplers)?;
+        let tonemap = TonemapPass::new(gpu, &uniforms, &targets, &samplers)?;
+        let profiler = Profiler::new(gpu, MAX_PASSES)?;
+        let frame_cmd = gpu.allocate_command_buffer()?;
+        let mut r = Self {
+            gpu,
+            settings: settings.clone(),
+            scene: scene_gpu,
+            targets,
+            samplers,
+            uniforms,
+            frame_uniforms,
+            rsm,
+            gbuffer,
+            direct,
+            composite,
+            tonemap,
+            profiler,
+            frame_cmd,
+        };
+        r.clear_indirect()?;
+        r.record_frame()?;
+        Ok(r)
+    }
+
+    pub fn uniforms(&self) -> &FrameUniforms {
+        &self.frame_uniforms
+    }
+
+    /// Method `none`: the indirect image holds zero, written once.
+    fn clear_indirect(&self) -> Result<()> {
+        let gpu = self.gpu;
+        let image = &self.targets.indirect;
+        gpu.run_once(|cmd| unsafe {
+            barrier::transition(
+                gpu,
+                cmd,
+                &[image],
+                Use::DISCARD_AFTER_READERS,
+                Use::TRANSFER_DST,
+            );
+            gpu.device.cmd_clear_color_image(
+                cmd,
+                image.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &vk::ClearColorValue { float32: [0.0; 4] },
+                &[image.range()],
+            );
+            barrier::transition(gpu, cmd, &[image], Use::TRANSFER_DST, Use::READ_ONLY);
+        })
+    }
+
+    /// Records the frame once; every `render_frames` submission replays it.
+    fn record_frame(&mut self) -> Result<()> {
+        let gpu = self.gpu;
+        let cmd = self.frame_cmd;
+        unsafe {
+            gpu.device
+                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?
+        };
+        let ctx = FrameContext {
+            gpu,
+            cmd,
+            scene: &self.scene,
+            targets: &self.targets,
+        };
+        let p = &mut self.profiler;
+        p.begin_frame(gpu, cmd);
+        self.rsm.record(&ctx, p);
+        self.gbuffer.record(&ctx, p);
+        self.direct.record(&ctx, p);
+        match self.settings.method {
+            Method::None => {} // indirect stays zero (cleared once in `new`)
+        }
+        self.composite.record(&ctx, p);
+        self.tonemap.record(&ctx, p);
+        unsafe { gpu.device.end_command_buffer(cmd)? };
+        Ok(())
+    }
+
+    /// Renders `n` frames, each submitted and waited for, and returns every
+    /// frame's per-pass numbers. `progress` is called after each frame.
+    pub fn render_frames(&mut self, n: u32, mut progress: impl FnMut(u32)) -> Result<FrameStats> {
+        let mut stats = FrameStats::default();
+        for i in 0..n {
+            let start = Instant::now();
+            self.gpu.submit_and_wait(self.frame_cmd)?;
+            stats.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
+            stats.frames.push(self.profiler.read(self.gpu)?);
+            progress(i + 1);
+        }
+        Ok(stats)
+    }
+
+    /// Copies every output back to the host. Call after `render_frames`.
+    pub fn readback(&self) -> Result<Readback> {
+        let t = &self.targets;
+        let images: [&Image; 10] = [
+            &t.final_radiance,
+            &t.direct,
+            &t.indirect,
+            &t.gbuffer_albedo,
+            &t.gbuffer_normal,
+            &t.gbuffer_position,
+            &t.display,
+            &t.rsm_position,
+            &t.rsm_normal,
+            &t.rsm_flux,
+        ];
+        let mut raw = read_images(self.gpu, &images)?.into_iter();
+        let mut next = || raw.next().unwrap();
+        let final_radiance = to_rgba_f32(&next(), t.final_radiance.format);
+        let direct = to_rgba_f32(&next(), t.direct.format);
+        let indirect = to_rgba_f32(&next(), t.indirect.format);
+        let albedo = to_rgba_f32(&next(), t.gbuffer_albedo.format);
+        let normal = to_rgba_f32(&next(), t.gbuffer_normal.format);
+        let position = to_rgba_f32(&next(), t.gbuffer_position.format);
+        let display = next();
+        let rsm = RsmReadback {
+            resolution: self.settings.rsm_resolution,
+            position: to_rgba_f32(&next(), t.rsm_position.format),
+            normal: to_rgba_f32(&next(), t.rsm_normal.format),
+            flux: to_rgba_f32(&next(), t.rsm_flux.format),
+        };
+        Ok(Readback {
+            width: self.settings.width,
+            height: self.settings.height,
+            final_radiance,
+            direct,
+            indirect,
+            albedo,
+            normal,
+            position,
+            display,
+            rsm,
+        })
+    }
+}
+
+/// Copies single-layer color images (left in `READ_ONLY` by their passes) into
+/// host memory, in one submission.
+fn read_images(gpu: &Gpu, images: &[&Image]) -> Result<Vec<Vec<u8>>> {
+    let mut buffers = Vec::new();
+    for img in images {
+        let size = img.extent.width as u64 * img.extent.height as u64 * texel_bytes(img.format);
+        buffers.push(Buffer::new(
+            gpu,
+            "readback",
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?);
+    }
+    let result = gpu.run_once(|cmd| unsafe {
+        barrier::transition(gpu, cmd, images, Use::READ_ONLY, Use::TRANSFER_SRC);
+        for (img, buf) in images.iter().zip(&buffers) {
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: img.aspect,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D {
+                    width: img.extent.width,
+                    height: img.extent.height,
+                    depth: 1,
+                });
+            gpu.device.cmd_copy_image_to_buffer(
+                cmd,
+                img.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buf.buffer,
+                &[region],
+            );
+        }
+        // Back to the convention's resting state, and the copies visible to the host.
+        barrier::transition(gpu, cmd, images, Use::TRANSFER_SRC, Use::READ_ONLY);
+        barrier::memory(
+            gpu,
+            cmd,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+    });
+    let out = buffers.iter().map(|b| b.mapped().to_vec()).collect();
+    for mut b in buffers {
+        b.destroy(gpu);
+    }
+    result.map(|_| out)
+}
+
+fn to_rgba_f32(bytes: &[u8], format: vk::Format) -> Vec<[f32; 4]> {
+    match format {
+        vk::Format::R32G32B32A32_SFLOAT => bytes
+            .chunks_exact(16)
+            .map(|c| {
+                std::array::from_fn(|i| f32::from_le_bytes(c[i * 4..i * 4 + 4].try_into().unwrap()))
+            })
+            .collect(),
+        vk::Format::R16G16B16A16_SFLOAT => bytes
+            .chunks_exact(8)
+            .map(|c| {
+                std::array::from_fn(|i| {
+                    half::f16::from_le_bytes(c[i * 2..i * 2 + 2].try_into().unwrap()).to_f32()
+                })
+            })
+            .collect(),
+        other => panic!("readback of {other:?} as f32 is not implemented"),
+    }
+}
+
+impl Drop for Renderer<'_> {
+    fn drop(&mut self) {
+        let gpu = self.gpu;
+        unsafe {
+            let _ = gpu.device.device_wait_idle();
+            gpu.device
+                .free_command_buffers(gpu.command_pool, &[self.frame_cmd]);
+        }
+        self.rsm.destroy(gpu);
+        self.gbuffer.destroy(gpu);
+        self.direct.destroy(gpu);
+        self.composite.destroy(gpu);
+        self.tonemap.destroy(gpu);
+        self.profiler.destroy(gpu);
+        for i in self.targets.all_mut() {
+            i.destroy(gpu);
+        }
+        self.scene.destroy(gpu);
+        self.uniforms.destroy(gpu);
+        self.samplers.destroy(gpu);
+    }
+}

@@ -1,0 +1,151 @@
+//! Per-pass GPU timings: the JSON written by `--timings` and the table the CLI prints.
+
+use crate::renderer::FrameStats;
+use serde::Serialize;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PassReport {
+    pub name: String,
+    /// True for passes that exist only for indirect light (ALGORITHM.md section 6).
+    pub indirect: bool,
+    pub gpu_ms_median: Option<f64>,
+    pub gpu_ms_min: Option<f64>,
+    /// Pipeline statistics (last frame). On lavapipe this counts rejected blocks too.
+    pub fragment_invocations: Option<u64>,
+    pub compute_invocations: Option<u64>,
+    /// Occlusion query (last frame): fragments that passed depth and stencil tests.
+    pub samples_passed: Option<u64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct TimingReport {
+    pub device: String,
+    pub driver: String,
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub rsm: u32,
+    pub method: String,
+    pub frames: usize,
+    pub passes: Vec<PassReport>,
+    /// Median over frames of the sum of all pass times.
+    pub total_gpu_ms_median: Option<f64>,
+    /// Median over frames of the sum of the indirect passes' times.
+    pub indirect_gpu_ms_median: Option<f64>,
+    /// Median CPU-measured time from submit to fence, for comparison.
+    pub wall_ms_median: f64,
+}
+
+pub fn median(values: &[f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+/// Identifies the run a report belongs to.
+pub struct RunInfo<'a> {
+    pub device: &'a str,
+    pub driver: &'a str,
+    pub scene: &'a str,
+    pub width: u32,
+    pub height: u32,
+    pub rsm: u32,
+    pub method: &'a str,
+}
+
+pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
+    let last = stats.frames.last().cloned().unwrap_or_default();
+    let passes = last
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let times: Vec<f64> = stats
+                .frames
+                .iter()
+                .filter_map(|f| f.get(i)?.gpu_ms)
+                .collect();
+            PassReport {
+                name: p.name.to_string(),
+                indirect: p.kind.indirect,
+                gpu_ms_median: median(&times),
+                gpu_ms_min: times.iter().copied().reduce(f64::min),
+                fragment_invocations: p.fragment_invocations,
+                compute_invocations: p.compute_invocations,
+                samples_passed: p.samples_passed,
+            }
+        })
+        .collect();
+    let frame_sum = |indirect_only: bool| -> Vec<f64> {
+        stats
+            .frames
+            .iter()
+            .filter_map(|f| {
+                f.iter()
+                    .filter(|p| !indirect_only || p.kind.indirect)
+                    .map(|p| p.gpu_ms)
+                    .try_fold(0.0, |acc, ms| Some(acc + ms?))
+            })
+            .collect()
+    };
+    TimingReport {
+        device: info.device.into(),
+        driver: info.driver.into(),
+        scene: info.scene.into(),
+        width: info.width,
+        height: info.height,
+        rsm: info.rsm,
+        method: info.method.into(),
+        frames: stats.frames.len(),
+        passes,
+        total_gpu_ms_median: median(&frame_sum(false)),
+        indirect_gpu_ms_median: median(&frame_sum(true)),
+        wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
+    }
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or("n/a".into(), |v| format!("{v:.3}"))
+}
+
+fn count(v: Option<u64>) -> String {
+    v.map_or("-".into(), |v| v.to_string())
+}
+
+/// The report as an aligned text table.
+pub fn table(r: &TimingReport) -> String {
+    let mut out = format!(
+        "{} | {} | {}x{} | rsm {} | method {} | {} frame(s)\n",
+        r.device, r.driver, r.width, r.height, r.rsm, r.method, r.frames
+    );
+    out += &format!(
+        "{:<12} {:>10} {:>10} {:>14} {:>14}\n",
+        "pass", "median ms", "min ms", "frag invoc.", "samples passed"
+    );
+    for p in &r.passes {
+        out += &format!(
+            "{:<12} {:>10} {:>10} {:>14} {:>14}{}\n",
+            p.name,
+            ms(p.gpu_ms_median),
+            ms(p.gpu_ms_min),
+            count(p.fragment_invocations),
+            count(p.samples_passed),
+            if p.indirect { "  (indirect)" } else { "" }
+        );
+    }
+    out += &format!(
+        "{:<12} {:>10}   indirect {} ms, wall {:.3} ms\n",
+        "total",
+        ms(r.total_gpu_ms_median),
+        ms(r.indirect_gpu_ms_median),
+        r.wall_ms_median
+    );
+    out
+}

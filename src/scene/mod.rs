@@ -1,0 +1,333 @@
+//! Scenes: triangle meshes placed by transforms, diffuse materials, one spot
+//! light and one perspective camera. Loaded from glTF (`gltf_load`), built in
+//! (`cornell`), or assembled by code (tests) with the helpers below.
+
+pub mod cornell;
+pub mod export;
+pub mod gltf_load;
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// One vertex as the vertex shaders read it (`shaders/scene.vert`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+}
+
+impl GpuVertex {
+    pub fn attributes() -> [ash::vk::VertexInputAttributeDescription; 3] {
+        use ash::vk;
+        let attr = |location, format, offset| vk::VertexInputAttributeDescription {
+            location,
+            binding: 0,
+            format,
+            offset: offset as u32,
+        };
+        [
+            attr(
+                0,
+                vk::Format::R32G32B32_SFLOAT,
+                std::mem::offset_of!(Self, position),
+            ),
+            attr(
+                1,
+                vk::Format::R32G32B32_SFLOAT,
+                std::mem::offset_of!(Self, normal),
+            ),
+            attr(2, vk::Format::R32G32_SFLOAT, std::mem::offset_of!(Self, uv)),
+        ]
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub name: String,
+    pub vertices: Vec<GpuVertex>,
+    pub indices: Vec<u32>,
+    pub material: usize,
+}
+
+/// A mesh placed in the world.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    pub mesh: usize,
+    pub world_from_object: Mat4,
+}
+
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear diffuse albedo (glTF `baseColorFactor`), multiplied by the texture.
+    pub base_color: Vec4,
+    /// Index into `Scene::textures` (glTF `baseColorTexture`, sRGB).
+    pub texture: Option<usize>,
+    /// Single-sided materials are back-face culled, as glTF specifies.
+    pub double_sided: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// sRGB-encoded RGBA8, rows top to bottom.
+    pub rgba8: Vec<u8>,
+}
+
+/// A `KHR_lights_punctual` spot light (ALGORITHM.md section 2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLight {
+    pub position: Vec3,
+    /// Unit vector the cone points along (the node's -Z).
+    pub direction: Vec3,
+    /// Linear RGB color.
+    pub color: Vec3,
+    /// Luminous intensity in candela, treated as W/sr.
+    pub intensity: f32,
+    /// Radians; attenuation is smooth between inner and outer.
+    pub inner_cone: f32,
+    pub outer_cone: f32,
+    /// Distance cut-off; `None` means none (the extension's default).
+    pub range: Option<f32>,
+}
+
+impl SpotLight {
+    /// The extension's angular attenuation, squared smoothstep between the cones.
+    pub fn angular_attenuation(&self, cos_angle: f64) -> f64 {
+        let (scale, offset) = self.cone_scale_offset();
+        let t = (cos_angle * scale as f64 + offset as f64).clamp(0.0, 1.0);
+        t * t
+    }
+
+    /// `lightAngleScale` and `lightAngleOffset` as KHR_lights_punctual defines them.
+    pub fn cone_scale_offset(&self) -> (f32, f32) {
+        let cos_outer = self.outer_cone.cos();
+        let cos_inner = self.inner_cone.cos();
+        let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+        (scale, -cos_outer * scale)
+    }
+
+    /// Radiant intensity (W/sr) toward world point `p`, per color channel,
+    /// including the range window when a range is set.
+    pub fn intensity_toward(&self, p: glam::DVec3) -> glam::DVec3 {
+        let to = p - self.position.as_dvec3();
+        let d = to.length();
+        let cos = to.dot(self.direction.as_dvec3()) / d;
+        let mut i = self.color.as_dvec3() * self.intensity as f64 * self.angular_attenuation(cos);
+        if let Some(range) = self.range {
+            let r = d / range as f64;
+            i *= (1.0 - r.powi(4)).clamp(0.0, 1.0);
+        }
+        i
+    }
+}
+
+/// A perspective camera looking down its local -Z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub world_from_camera: Mat4,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+    pub znear: f32,
+}
+
+impl Camera {
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, yfov: f32, znear: f32) -> Self {
+        Self {
+            world_from_camera: Mat4::look_at_rh(eye, target, up).inverse(),
+            yfov,
+            znear,
+        }
+    }
+
+    pub fn position(&self) -> Vec3 {
+        self.world_from_camera.w_axis.truncate()
+    }
+
+    pub fn forward(&self) -> Vec3 {
+        (-self.world_from_camera.z_axis.truncate()).normalize()
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub instances: Vec<Instance>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub light: SpotLight,
+    pub camera: Camera,
+    /// Things the loader skipped or assumed, printed by the CLI.
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// An empty scene with the given light and camera, for code that builds scenes.
+    pub fn empty(name: &str, light: SpotLight, camera: Camera) -> Self {
+        Self {
+            name: name.into(),
+            meshes: vec![],
+            instances: vec![],
+            materials: vec![],
+            textures: vec![],
+            light,
+            camera,
+            warnings: vec![],
+        }
+    }
+
+    pub fn add_material(&mut self, name: &str, albedo: Vec3) -> usize {
+        self.materials.push(Material {
+            name: name.into(),
+            base_color: albedo.extend(1.0),
+            texture: None,
+            double_sided: false,
+        });
+        self.materials.len() - 1
+    }
+
+    /// Adds a mesh with one instance at the identity transform.
+    pub fn add_mesh(
+        &mut self,
+        name: &str,
+        vertices: Vec<GpuVertex>,
+        indices: Vec<u32>,
+        material: usize,
+    ) {
+        self.meshes.push(Mesh {
+            name: name.into(),
+            vertices,
+            indices,
+            material,
+        });
+        self.instances.push(Instance {
+            mesh: self.meshes.len() - 1,
+            world_from_object: Mat4::IDENTITY,
+        });
+    }
+
+    /// Adds the planar quad `corners` (counter-clockwise seen from its front).
+    pub fn add_quad(&mut self, name: &str, corners: [Vec3; 4], material: usize) {
+        let (v, i) = quad(corners);
+        self.add_mesh(name, v, i, material);
+    }
+
+    /// World-space bounding box of all instances, or `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for inst in &self.instances {
+            for v in &self.meshes[inst.mesh].vertices {
+                let p = inst
+                    .world_from_object
+                    .transform_point3(Vec3::from(v.position));
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh].indices.len() / 3)
+            .sum()
+    }
+}
+
+/// Vertices and indices of a planar quad given counter-clockwise from its front.
+pub fn quad(c: [Vec3; 4]) -> (Vec<GpuVertex>, Vec<u32>) {
+    let n = (c[1] - c[0]).cross(c[2] - c[0]).normalize();
+    let uvs = [
+        Vec2::new(0.0, 1.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(0.0, 0.0),
+    ];
+    let vertices = c
+        .iter()
+        .zip(uvs)
+        .map(|(p, uv)| GpuVertex {
+            position: p.to_array(),
+            normal: n.to_array(),
+            uv: uv.to_array(),
+        })
+        .collect();
+    (vertices, vec![0, 1, 2, 0, 2, 3])
+}
+
+/// A closed box with outward faces: `center`, full `size`, turned by `yaw` radians about +Y.
+pub fn cuboid(center: Vec3, size: Vec3, yaw: f32) -> (Vec<GpuVertex>, Vec<u32>) {
+    let rot = glam::Quat::from_rotation_y(yaw);
+    let h = size * 0.5;
+    let corner = |x: f32, y: f32, z: f32| center + rot * Vec3::new(x * h.x, y * h.y, z * h.z);
+    // Each face counter-clockwise seen from outside.
+    let faces = [
+        [
+            corner(-1., -1., 1.),
+            corner(1., -1., 1.),
+            corner(1., 1., 1.),
+            corner(-1., 1., 1.),
+        ], // +z
+        [
+            corner(1., -1., -1.),
+            corner(-1., -1., -1.),
+            corner(-1., 1., -1.),
+            corner(1., 1., -1.),
+        ], // -z
+        [
+            corner(1., -1., 1.),
+            corner(1., -1., -1.),
+            corner(1., 1., -1.),
+            corner(1., 1., 1.),
+        ], // +x
+        [
+            corner(-1., -1., -1.),
+            corner(-1., -1., 1.),
+            corner(-1., 1., 1.),
+            corner(-1., 1., -1.),
+        ], // -x
+        [
+            corner(-1., 1., 1.),
+            corner(1., 1., 1.),
+            corner(1., 1., -1.),
+            corner(-1., 1., -1.),
+        ], // +y
+        [
+            corner(-1., -1., -1.),
+            corner(1., -1., -1.),
+            corner(1., -1., 1.),
+            corner(-1., -1., 1.),
+        ], // -y
+    ];
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    for f in faces {
+        let (v, i) = quad(f);
+        let base = vertices.len() as u32;
+        vertices.extend(v);
+        indices.extend(i.into_iter().map(|i| i + base));
+    }
+    (vertices, indices)
+}
+
+/// Face normals accumulated per vertex, for primitives without NORMAL.
+pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
+    let mut acc = vec![Vec3::ZERO; vertices.len()];
+    for t in indices.chunks_exact(3) {
+        let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
+        // Area-weighted: the cross product's length is twice the area.
+        let n = (p(1) - p(0)).cross(p(2) - p(0));
+        for &k in t {
+            acc[k as usize] += n;
+        }
+    }
+    for (v, n) in vertices.iter_mut().zip(acc) {
+        v.normal = n.normalize_or(Vec3::Y).to_array();
+    }
+}

@@ -1,0 +1,126 @@
+//! Small synchronization2 helpers. Passes call these right beside the draws they
+//! guard, so every barrier is read where it matters.
+//!
+//! The convention every pass follows (see `passes/mod.rs`): a pass first makes
+//! its outputs writable (discarding old contents, after earlier readers are done),
+//! and when it has finished it leaves every image it wrote in
+//! `SHADER_READ_ONLY_OPTIMAL`, with its writes visible to the stages in
+//! [`READERS`]. Consumers therefore need no barrier for their inputs.
+
+use super::resources::Image;
+use super::Gpu;
+use ash::vk;
+
+/// Every stage that may read a finished pass output: fragment and compute
+/// shaders, and the readback copy.
+pub const READERS: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
+    vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
+        | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
+        | vk::PipelineStageFlags2::COPY.as_raw(),
+);
+pub const READ_ACCESS: vk::AccessFlags2 = vk::AccessFlags2::from_raw(
+    vk::AccessFlags2::SHADER_SAMPLED_READ.as_raw()
+        | vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+        | vk::AccessFlags2::TRANSFER_READ.as_raw(),
+);
+
+/// Where and how an image is used on one side of a barrier.
+#[derive(Clone, Copy, Debug)]
+pub struct Use {
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+    pub layout: vk::ImageLayout,
+}
+
+impl Use {
+    /// Contents are discarded; waits for the previous readers (write-after-read).
+    pub const DISCARD_AFTER_READERS: Use = Use {
+        stage: READERS,
+        access: vk::AccessFlags2::NONE,
+        layout: vk::ImageLayout::UNDEFINED,
+    };
+    pub const COLOR_ATTACHMENT: Use = Use {
+        stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw()
+                | vk::AccessFlags2::COLOR_ATTACHMENT_READ.as_raw(),
+        ),
+        layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+    };
+    pub const DEPTH_ATTACHMENT: Use = Use {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+        ),
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
+                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw(),
+        ),
+        layout: vk::ImageLayout::ATTACHMENT_OPTIMAL,
+    };
+    pub const TRANSFER_DST: Use = Use {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::CLEAR.as_raw(),
+        ),
+        access: vk::AccessFlags2::TRANSFER_WRITE,
+        layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+    };
+    pub const TRANSFER_SRC: Use = Use {
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+    };
+    /// The state every finished pass output is left in.
+    pub const READ_ONLY: Use = Use {
+        stage: READERS,
+        access: READ_ACCESS,
+        layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+    };
+}
+
+pub fn image(image: &Image, from: Use, to: Use) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(from.stage)
+        .src_access_mask(from.access)
+        .dst_stage_mask(to.stage)
+        .dst_access_mask(to.access)
+        .old_layout(from.layout)
+        .new_layout(to.layout)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image.image)
+        .subresource_range(image.range())
+}
+
+/// Records one `vkCmdPipelineBarrier2` for `barriers`.
+pub fn images(gpu: &Gpu, cmd: vk::CommandBuffer, barriers: &[vk::ImageMemoryBarrier2]) {
+    if barriers.is_empty() {
+        return;
+    }
+    let dep = vk::DependencyInfo::default().image_memory_barriers(barriers);
+    unsafe { gpu.device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+/// Transitions each image from `from` to `to` in one barrier call.
+pub fn transition(gpu: &Gpu, cmd: vk::CommandBuffer, targets: &[&Image], from: Use, to: Use) {
+    let barriers: Vec<_> = targets.iter().map(|i| image(i, from, to)).collect();
+    images(gpu, cmd, &barriers);
+}
+
+/// A global memory barrier (buffers, host visibility).
+pub fn memory(
+    gpu: &Gpu,
+    cmd: vk::CommandBuffer,
+    src_stage: vk::PipelineStageFlags2,
+    src_access: vk::AccessFlags2,
+    dst_stage: vk::PipelineStageFlags2,
+    dst_access: vk::AccessFlags2,
+) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)];
+    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { gpu.device.cmd_pipeline_barrier2(cmd, &dep) };
+}

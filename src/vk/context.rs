@@ -1,0 +1,541 @@
+//! The Vulkan instance, device and queue, the allocator, and the validation-layer
+//! log. Everything else borrows a [`Gpu`].
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_void, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::Mutex;
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// Help printed whenever no usable Vulkan driver is found.
+pub const INSTALL_DRIVER_HINT: &str =
+    "install a Vulkan driver: on Debian or Ubuntu without a GPU, \
+     `sudo apt-get install mesa-vulkan-drivers libvulkan1` gives the lavapipe CPU driver \
+     (or run `bash .ci/install-vulkan`); on a machine with a GPU, install its vendor's driver";
+
+/// Whether to load the Khronos validation layer (with synchronization validation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Validation {
+    Off,
+    /// On when the layer is installed, silently off otherwise (used by tests that
+    /// are not about validation).
+    IfInstalled,
+    /// On, and an error when the layer is missing.
+    Required,
+}
+
+#[derive(Clone, Debug)]
+pub struct GpuOptions {
+    pub validation: Validation,
+    /// Index into [`list_devices`]; `None` picks the best device.
+    pub device_index: Option<usize>,
+}
+
+impl Default for GpuOptions {
+    fn default() -> Self {
+        Self {
+            validation: Validation::Off,
+            device_index: None,
+        }
+    }
+}
+
+/// What `isr devices` prints about one physical device.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub index: usize,
+    pub name: String,
+    pub kind: vk::PhysicalDeviceType,
+    pub driver: String,
+    pub api_version: (u32, u32, u32),
+    /// Why the device cannot run `isr`, if it cannot.
+    pub unusable: Option<String>,
+}
+
+impl DeviceInfo {
+    pub fn kind_name(&self) -> &'static str {
+        match self.kind {
+            vk::PhysicalDeviceType::DISCRETE_GPU => "discrete",
+            vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated",
+            vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual",
+            vk::PhysicalDeviceType::CPU => "cpu",
+            _ => "other",
+        }
+    }
+}
+
+/// Optional device features `isr` uses when present and reports as missing otherwise.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OptionalFeatures {
+    pub pipeline_statistics: bool,
+    pub precise_occlusion: bool,
+    /// `timestampValidBits > 0` on the queue and `timestampComputeAndGraphics`.
+    pub timestamps: bool,
+}
+
+/// Messages the validation layer reported, collected so that tests can fail on them.
+#[derive(Default)]
+pub struct ValidationLog {
+    messages: Mutex<Vec<String>>,
+}
+
+impl ValidationLog {
+    pub fn take(&self) -> Vec<String> {
+        std::mem::take(&mut *self.messages.lock().unwrap())
+    }
+}
+
+pub struct Gpu {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub device: ash::Device,
+    pub physical: vk::PhysicalDevice,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub properties: vk::PhysicalDeviceProperties,
+    pub info: DeviceInfo,
+    pub features: OptionalFeatures,
+    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub command_pool: vk::CommandPool,
+    debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// Object names and command labels, present when VK_EXT_debug_utils is.
+    pub debug_device: Option<ash::ext::debug_utils::Device>,
+    validation_log: Option<Box<ValidationLog>>,
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    let message = if data.is_null() || (*data).p_message.is_null() {
+        String::from("(no message)")
+    } else {
+        CStr::from_ptr((*data).p_message)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let level = if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        "error"
+    } else {
+        "warning"
+    };
+    eprintln!("validation {level}: {message}");
+    if let Some(log) = (user as *const ValidationLog).as_ref() {
+        log.messages
+            .lock()
+            .unwrap()
+            .push(format!("{level}: {message}"));
+    }
+    vk::FALSE
+}
+
+fn load_entry() -> Result<ash::Entry> {
+    // SAFETY: loading the system Vulkan loader; no Vulkan calls are in flight.
+    unsafe { ash::Entry::load() }.map_err(|e| {
+        anyhow!("could not load the Vulkan loader (libvulkan.so.1): {e}; {INSTALL_DRIVER_HINT}")
+    })
+}
+
+fn layer_installed(entry: &ash::Entry) -> bool {
+    unsafe { entry.enumerate_instance_layer_properties() }
+        .unwrap_or_default()
+        .iter()
+        .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+}
+
+fn create_instance(entry: &ash::Entry, validate: bool) -> Result<ash::Instance> {
+    let app = vk::ApplicationInfo::default()
+        .application_name(c"isr")
+        .api_version(vk::API_VERSION_1_3);
+    let available: Vec<String> = unsafe { entry.enumerate_instance_extension_properties(None) }
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|e| e.extension_name_as_c_str().ok())
+        .map(|s| s.to_string_lossy().into_owned())
+        .collect();
+    let mut extensions = Vec::new();
+    if validate || available.iter().any(|e| e == "VK_EXT_debug_utils") {
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    let mut layers = Vec::new();
+    let sync_validation = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features =
+        vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync_validation);
+    let mut info = vk::InstanceCreateInfo::default().application_info(&app);
+    if validate {
+        layers.push(VALIDATION_LAYER.as_ptr());
+        // The layer itself provides VK_EXT_validation_features.
+        extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        info = info.push_next(&mut features);
+    }
+    let info = info
+        .enabled_extension_names(&extensions)
+        .enabled_layer_names(&layers);
+    match unsafe { entry.create_instance(&info, None) } {
+        Ok(i) => Ok(i),
+        Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
+            bail!("no Vulkan 1.3 driver found (vkCreateInstance: ERROR_INCOMPATIBLE_DRIVER); {INSTALL_DRIVER_HINT}")
+        }
+        Err(e) => bail!("vkCreateInstance failed: {e}; {INSTALL_DRIVER_HINT}"),
+    }
+}
+
+fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> DeviceInfo {
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
+    let p = props2.properties;
+    let v = p.api_version;
+    let api_version = (
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v),
+    );
+    let name = p
+        .device_name_as_c_str()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let driver_name = driver
+        .driver_name_as_c_str()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let driver_info = driver
+        .driver_info_as_c_str()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let unusable = unusable_reason(instance, pd, p);
+    DeviceInfo {
+        index,
+        name,
+        kind: p.device_type,
+        driver: format!("{driver_name} {driver_info}").trim().to_string(),
+        api_version,
+        unusable,
+    }
+}
+
+fn graphics_queue_family(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Option<u32> {
+    let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    families
+        .iter()
+        .position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        })
+        .map(|i| i as u32)
+}
+
+fn unusable_reason(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    p: vk::PhysicalDeviceProperties,
+) -> Option<String> {
+    if p.api_version < vk::API_VERSION_1_3 {
+        return Some(format!(
+            "supports Vulkan {}.{} only; isr needs 1.3",
+            vk::api_version_major(p.api_version),
+            vk::api_version_minor(p.api_version)
+        ));
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    if f13.dynamic_rendering == vk::FALSE || f13.synchronization2 == vk::FALSE {
+        return Some("lacks dynamicRendering or synchronization2".into());
+    }
+    if graphics_queue_family(instance, pd).is_none() {
+        return Some("has no graphics+compute queue".into());
+    }
+    None
+}
+
+fn type_rank(kind: vk::PhysicalDeviceType) -> u32 {
+    match kind {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 3,
+        _ => 4,
+    }
+}
+
+/// Every physical device the loader reports, in the loader's order (the index
+/// `--device` takes).
+pub fn list_devices() -> Result<Vec<DeviceInfo>> {
+    let entry = load_entry()?;
+    let instance = create_instance(&entry, false)?;
+    let devices = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
+    let infos = devices
+        .iter()
+        .enumerate()
+        .map(|(i, &pd)| describe(&instance, i, pd))
+        .collect();
+    unsafe { instance.destroy_instance(None) };
+    Ok(infos)
+}
+
+impl Gpu {
+    pub fn new(options: &GpuOptions) -> Result<Self> {
+        let entry = load_entry()?;
+        let validate = match options.validation {
+            Validation::Off => false,
+            Validation::IfInstalled => layer_installed(&entry),
+            Validation::Required => {
+                if !layer_installed(&entry) {
+                    bail!(
+                        "--validate needs the Khronos validation layer, which is not installed; \
+                         on Debian or Ubuntu: `sudo apt-get install vulkan-validationlayers`"
+                    );
+                }
+                true
+            }
+        };
+        let instance = create_instance(&entry, validate)?;
+        // From here on, failures must destroy the instance; a guard keeps that simple.
+        let guard = InstanceGuard(Some(instance.clone()));
+
+        let mut validation_log = None;
+        let mut debug_utils = None;
+        if validate {
+            let log = Box::new(ValidationLog::default());
+            let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE
+                        | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL,
+                )
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(&*log as *const ValidationLog as *mut c_void);
+            let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
+                .context("creating the validation debug messenger")?;
+            debug_utils = Some((loader, messenger));
+            validation_log = Some(log);
+        }
+
+        let physical_devices = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
+        if physical_devices.is_empty() {
+            bail!("no Vulkan device found; {INSTALL_DRIVER_HINT}");
+        }
+        let infos: Vec<DeviceInfo> = physical_devices
+            .iter()
+            .enumerate()
+            .map(|(i, &pd)| describe(&instance, i, pd))
+            .collect();
+        let info = match options.device_index {
+            Some(i) => {
+                let Some(info) = infos.get(i) else {
+                    bail!(
+                        "--device {i}: there are only {} Vulkan devices (indices 0..{}); `isr devices` lists them",
+                        infos.len(),
+                        infos.len() - 1
+                    );
+                };
+                if let Some(why) = &info.unusable {
+                    bail!("--device {i} ({}) cannot run isr: it {why}", info.name);
+                }
+                info.clone()
+            }
+            None => infos
+                .iter()
+                .filter(|d| d.unusable.is_none())
+                .min_by_key(|d| (type_rank(d.kind), d.index))
+                .cloned()
+                .ok_or_else(|| {
+                    let list: Vec<String> = infos
+                        .iter()
+                        .map(|d| format!("{} ({})", d.name, d.unusable.clone().unwrap_or_default()))
+                        .collect();
+                    anyhow!(
+                        "no Vulkan device can run isr: {}; {INSTALL_DRIVER_HINT}",
+                        list.join(", ")
+                    )
+                })?,
+        };
+        let physical = physical_devices[info.index];
+        let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let queue_family = graphics_queue_family(&instance, physical).unwrap();
+        let family_props =
+            unsafe { instance.get_physical_device_queue_family_properties(physical) }
+                [queue_family as usize];
+
+        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let features = OptionalFeatures {
+            pipeline_statistics: supported.pipeline_statistics_query == vk::TRUE,
+            precise_occlusion: supported.occlusion_query_precise == vk::TRUE,
+            timestamps: family_props.timestamp_valid_bits > 0
+                && properties.limits.timestamp_compute_and_graphics == vk::TRUE,
+        };
+        let enabled = vk::PhysicalDeviceFeatures::default()
+            .pipeline_statistics_query(features.pipeline_statistics)
+            .occlusion_query_precise(features.precise_occlusion);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true);
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_features(&enabled)
+            .push_next(&mut f13);
+        let device = unsafe { instance.create_device(physical, &device_info, None) }
+            .with_context(|| format!("creating a Vulkan device on {}", info.name))?;
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .context("creating the GPU memory allocator")?;
+
+        let command_pool = unsafe {
+            device.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(queue_family)
+                    .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                None,
+            )
+        }?;
+        let debug_device = debug_utils
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        std::mem::forget(guard);
+        Ok(Self {
+            entry,
+            instance,
+            device,
+            physical,
+            queue,
+            queue_family,
+            properties,
+            info,
+            features,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            command_pool,
+            debug_utils,
+            debug_device,
+            validation_log,
+        })
+    }
+
+    /// True when the validation layer is loaded.
+    pub fn validating(&self) -> bool {
+        self.validation_log.is_some()
+    }
+
+    /// Validation messages reported since the last call.
+    pub fn take_validation_messages(&self) -> Vec<String> {
+        self.validation_log
+            .as_ref()
+            .map(|l| l.take())
+            .unwrap_or_default()
+    }
+
+    pub fn limits(&self) -> &vk::PhysicalDeviceLimits {
+        &self.properties.limits
+    }
+
+    pub fn allocate_command_buffer(&self) -> Result<vk::CommandBuffer> {
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.command_pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        Ok(unsafe { self.device.allocate_command_buffers(&info) }?[0])
+    }
+
+    /// Submits `cmd` and blocks until the GPU has finished it.
+    pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
+        let fence = unsafe {
+            self.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        let result = unsafe {
+            self.device
+                .queue_submit2(self.queue, &submit, fence)
+                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX))
+        };
+        unsafe { self.device.destroy_fence(fence, None) };
+        result.map_err(|e| match e {
+            vk::Result::ERROR_DEVICE_LOST => anyhow!(
+                "the GPU device was lost (a driver timeout or crash); try a smaller --width/--height or --rsm"
+            ),
+            e => anyhow!("queue submission failed: {e}"),
+        })
+    }
+
+    /// Records commands with `record` into a fresh command buffer, runs them and waits.
+    pub fn run_once(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let cmd = self.allocate_command_buffer()?;
+        unsafe {
+            self.device.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+        }
+        record(cmd);
+        let result = unsafe { self.device.end_command_buffer(cmd) }
+            .map_err(anyhow::Error::from)
+            .and_then(|_| self.submit_and_wait(cmd));
+        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+        result
+    }
+
+    /// Names a Vulkan object for validation messages and capture tools.
+    pub fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+        if let Some(d) = &self.debug_device {
+            let Ok(cname) = std::ffi::CString::new(name) else {
+                return;
+            };
+            let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                .object_handle(handle)
+                .object_name(&cname);
+            unsafe {
+                let _ = d.set_debug_utils_object_name(&info);
+            }
+        }
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+            if let Some((loader, messenger)) = self.debug_utils.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// Destroys the instance if device creation fails half-way.
+struct InstanceGuard(Option<ash::Instance>);
+
+impl Drop for InstanceGuard {
+    fn drop(&mut self) {
+        if let Some(i) = self.0.take() {
+            unsafe { i.destroy_instance(None) };
+        }
+    }
+}

@@ -1,0 +1,10 @@
+//! Thin layers over ash: device, resources, barriers, pipelines, timing.
+
+pub mod barrier;
+pub mod context;
+pub mod pipeline;
+pub mod profiler;
+pub mod resources;
+
+pub use context::{Gpu, GpuOptions, Validation};
+pub use resources::{Buffer, Image, ImageDesc};

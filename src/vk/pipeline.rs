@@ -1,0 +1,321 @@
+//! Shader modules from the embedded SPIR-V, descriptor sets, and graphics
+//! pipelines for dynamic rendering.
+
+use super::Gpu;
+use anyhow::{anyhow, Context as _, Result};
+use ash::vk;
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+/// The SPIR-V words of `shaders/<name>`, compiled by `build.rs`.
+pub fn spirv(name: &str) -> Result<Vec<u32>> {
+    let bytes = embedded::SPIRV
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| anyhow!("no compiled shader named {name} (is shaders/{name} present?)"))?;
+    Ok(ash::util::read_spv(&mut std::io::Cursor::new(bytes))?)
+}
+
+/// Names of every embedded shader.
+pub fn shader_names() -> impl Iterator<Item = &'static str> {
+    embedded::SPIRV.iter().map(|(n, _)| *n)
+}
+
+fn shader_module(gpu: &Gpu, name: &str) -> Result<vk::ShaderModule> {
+    let code = spirv(name)?;
+    let module = unsafe {
+        gpu.device
+            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None)
+    }
+    .with_context(|| format!("creating shader module {name}"))?;
+    gpu.name(module, name);
+    Ok(module)
+}
+
+/// One descriptor binding, visible to every shader stage of the pipeline.
+#[derive(Clone, Copy)]
+pub enum Binding<'a> {
+    Uniform(&'a super::Buffer),
+    Storage(&'a super::Buffer),
+    /// A combined image sampler in `SHADER_READ_ONLY_OPTIMAL`.
+    Sampled(vk::ImageView, vk::Sampler),
+    /// An array of combined image samplers.
+    SampledArray(&'a [vk::ImageView], vk::Sampler),
+}
+
+/// A descriptor set layout, its pool and the one set allocated from it.
+/// Passes write their set once at creation: their inputs never change.
+pub struct DescriptorSet {
+    pub layout: vk::DescriptorSetLayout,
+    pub pool: vk::DescriptorPool,
+    pub set: vk::DescriptorSet,
+}
+
+impl DescriptorSet {
+    pub fn new(gpu: &Gpu, name: &str, bindings: &[Binding]) -> Result<Self> {
+        let stages = vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE;
+        let kind = |b: &Binding| match b {
+            Binding::Uniform(_) => (vk::DescriptorType::UNIFORM_BUFFER, 1),
+            Binding::Storage(_) => (vk::DescriptorType::STORAGE_BUFFER, 1),
+            Binding::Sampled(..) => (vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+            Binding::SampledArray(views, _) => (
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                views.len() as u32,
+            ),
+        };
+        let layout_bindings: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let (ty, count) = kind(b);
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(ty)
+                    .descriptor_count(count)
+                    .stage_flags(stages)
+            })
+            .collect();
+        let layout = unsafe {
+            gpu.device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
+                None,
+            )
+        }?;
+        let sizes: Vec<_> = layout_bindings
+            .iter()
+            .map(|b| vk::DescriptorPoolSize {
+                ty: b.descriptor_type,
+                descriptor_count: b.descriptor_count,
+            })
+            .collect();
+        let pool = unsafe {
+            gpu.device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }?;
+        let layouts = [layout];
+        let set = unsafe {
+            gpu.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .with_context(|| format!("allocating descriptor set for {name}"))?[0];
+
+        let buffer_infos: Vec<Vec<vk::DescriptorBufferInfo>> = bindings
+            .iter()
+            .map(|b| match b {
+                Binding::Uniform(buf) | Binding::Storage(buf) => vec![vk::DescriptorBufferInfo {
+                    buffer: buf.buffer,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }],
+                _ => vec![],
+            })
+            .collect();
+        let image_infos: Vec<Vec<vk::DescriptorImageInfo>> = bindings
+            .iter()
+            .map(|b| {
+                let info = |view: vk::ImageView, sampler: vk::Sampler| vk::DescriptorImageInfo {
+                    sampler,
+                    image_view: view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                };
+                match b {
+                    Binding::Sampled(view, sampler) => vec![info(*view, *sampler)],
+                    Binding::SampledArray(views, sampler) => {
+                        views.iter().map(|v| info(*v, *sampler)).collect()
+                    }
+                    _ => vec![],
+                }
+            })
+            .collect();
+        let writes: Vec<_> = layout_bindings
+            .iter()
+            .enumerate()
+            .map(|(i, lb)| {
+                let w = vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(lb.descriptor_type);
+                if buffer_infos[i].is_empty() {
+                    w.image_info(&image_infos[i])
+                } else {
+                    w.buffer_info(&buffer_infos[i])
+                }
+            })
+            .collect();
+        unsafe { gpu.device.update_descriptor_sets(&writes, &[]) };
+        Ok(Self { layout, pool, set })
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        unsafe {
+            gpu.device.destroy_descriptor_pool(self.pool, None);
+            gpu.device.destroy_descriptor_set_layout(self.layout, None);
+        }
+    }
+}
+
+/// glTF front faces are counter-clockwise seen from the front. Vulkan's
+/// orientation is the one seen in the framebuffer, and the projections flip y
+/// so images stay upright, so the winding the camera sees is kept.
+pub const FRONT_FACE: vk::FrontFace = vk::FrontFace::COUNTER_CLOCKWISE;
+
+/// How a graphics pipeline rasterizes and what it writes.
+pub struct GraphicsDesc<'a> {
+    pub name: &'a str,
+    pub vertex_shader: &'a str,
+    pub fragment_shader: &'a str,
+    pub set_layouts: &'a [vk::DescriptorSetLayout],
+    pub push_constant_bytes: u32,
+    /// Scene vertex input (`scene::GpuVertex`); `false` for full-screen triangles.
+    pub scene_vertices: bool,
+    pub color_formats: &'a [vk::Format],
+    pub depth_format: vk::Format,
+    /// Depth test with this compare op and depth writes; `None` disables both.
+    pub depth_test: Option<vk::CompareOp>,
+    /// Cull mode is set per draw (glTF `doubleSided`), so it is dynamic state.
+    pub dynamic_cull: bool,
+    /// Integer specialization constants, by constant id.
+    pub specialization: &'a [(u32, i32)],
+}
+
+pub struct Pipeline {
+    pub pipeline: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+}
+
+impl Pipeline {
+    pub fn graphics(gpu: &Gpu, desc: &GraphicsDesc) -> Result<Self> {
+        let push = [vk::PushConstantRange {
+            stage_flags: vk::ShaderStageFlags::ALL_GRAPHICS,
+            offset: 0,
+            size: desc.push_constant_bytes,
+        }];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(desc.set_layouts);
+        if desc.push_constant_bytes > 0 {
+            layout_info = layout_info.push_constant_ranges(&push);
+        }
+        let layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }?;
+
+        let vs = shader_module(gpu, desc.vertex_shader)?;
+        let fs = shader_module(gpu, desc.fragment_shader)?;
+        let spec_entries: Vec<_> = desc
+            .specialization
+            .iter()
+            .enumerate()
+            .map(|(i, (id, _))| vk::SpecializationMapEntry {
+                constant_id: *id,
+                offset: (i * 4) as u32,
+                size: 4,
+            })
+            .collect();
+        let spec_data: Vec<u8> = desc
+            .specialization
+            .iter()
+            .flat_map(|(_, v)| v.to_ne_bytes())
+            .collect();
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&spec_entries)
+            .data(&spec_data);
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vs)
+                .name(c"main")
+                .specialization_info(&spec),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fs)
+                .name(c"main")
+                .specialization_info(&spec),
+        ];
+
+        let vertex_bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: std::mem::size_of::<crate::scene::GpuVertex>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let vertex_attributes = crate::scene::GpuVertex::attributes();
+        let mut vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+        if desc.scene_vertices {
+            vertex_input = vertex_input
+                .vertex_binding_descriptions(&vertex_bindings)
+                .vertex_attribute_descriptions(&vertex_attributes);
+        }
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::NONE)
+            .front_face(FRONT_FACE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_test.is_some())
+            .depth_write_enable(desc.depth_test.is_some())
+            .depth_compare_op(desc.depth_test.unwrap_or(vk::CompareOp::ALWAYS));
+        let blend_attachments: Vec<_> = desc
+            .color_formats
+            .iter()
+            .map(|_| {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            })
+            .collect();
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let mut dynamic_states = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        if desc.dynamic_cull {
+            // Front face is dynamic too: lavapipe (Mesa 22.3) ignores the static
+            // front face once cull mode is dynamic.
+            dynamic_states.extend([vk::DynamicState::CULL_MODE, vk::DynamicState::FRONT_FACE]);
+        }
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(desc.color_formats)
+            .depth_attachment_format(desc.depth_format);
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .push_next(&mut rendering);
+        let result = unsafe {
+            gpu.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        unsafe {
+            gpu.device.destroy_shader_module(vs, None);
+            gpu.device.destroy_shader_module(fs, None);
+        }
+        let pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {}: {e}", desc.name))?[0];
+        gpu.name(pipeline, desc.name);
+        Ok(Self { pipeline, layout })
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        unsafe {
+            gpu.device.destroy_pipeline(self.pipeline, None);
+            gpu.device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}

@@ -1,0 +1,262 @@
+//! Named GPU timing scopes: a timestamp, a pipeline-statistics query and an
+//! occlusion query around every pass, plus a debug label.
+//!
+//! Timing model. Lavapipe (Mesa 22.3) bins the commands of one command buffer,
+//! so a timestamp written just *before* a pass reads close to that pass's *end*.
+//! Differences between consecutive *end-of-pass* timestamps do add up to the
+//! frame's wall time. So the frame writes one timestamp at its start and one
+//! after each pass, and a pass's time is the difference to the previous one.
+//! On a tiling or immediate GPU this is the same as begin/end pairs, minus
+//! bubbles between passes (which are charged to the following pass).
+//!
+//! Fragment counts. Lavapipe's FRAGMENT_SHADER_INVOCATIONS counts every
+//! rasterized block, stencil- and depth-rejected ones included, so the occlusion
+//! query (`samples_passed`) is what counts fragments that pass the tests.
+
+use super::Gpu;
+use anyhow::Result;
+use ash::vk;
+
+/// What kind of work a pass does, for the queries it can hold and the
+/// "indirect time" sum (ALGORITHM.md section 6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassKind {
+    /// Draws inside a render-pass instance (occlusion queries are meaningful).
+    pub graphics: bool,
+    /// Exists only for indirect light.
+    pub indirect: bool,
+}
+
+/// One pass's numbers from one frame.
+#[derive(Clone, Debug)]
+pub struct PassSample {
+    pub name: &'static str,
+    pub kind: PassKind,
+    pub gpu_ms: Option<f64>,
+    pub fragment_invocations: Option<u64>,
+    pub compute_invocations: Option<u64>,
+    pub samples_passed: Option<u64>,
+}
+
+pub struct Profiler {
+    capacity: u32,
+    timestamps: Option<vk::QueryPool>,
+    statistics: Option<vk::QueryPool>,
+    occlusion: vk::QueryPool,
+    precise_occlusion: bool,
+    timestamp_mask: u64,
+    ns_per_tick: f64,
+    passes: Vec<(&'static str, PassKind)>,
+}
+
+const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFlags::from_raw(
+    vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS.as_raw()
+        | vk::QueryPipelineStatisticFlags::COMPUTE_SHADER_INVOCATIONS.as_raw(),
+);
+
+impl Profiler {
+    /// Room for `capacity` passes per frame.
+    pub fn new(gpu: &Gpu, capacity: u32) -> Result<Self> {
+        let create = |ty: vk::QueryType, count: u32, stats| unsafe {
+            gpu.device.create_query_pool(
+                &vk::QueryPoolCreateInfo::default()
+                    .query_type(ty)
+                    .query_count(count)
+                    .pipeline_statistics(stats),
+                None,
+            )
+        };
+        let timestamps = if gpu.features.timestamps {
+            Some(create(
+                vk::QueryType::TIMESTAMP,
+                capacity + 1,
+                vk::QueryPipelineStatisticFlags::empty(),
+            )?)
+        } else {
+            None
+        };
+        let statistics = if gpu.features.pipeline_statistics {
+            Some(create(
+                vk::QueryType::PIPELINE_STATISTICS,
+                capacity,
+                STATISTICS,
+            )?)
+        } else {
+            None
+        };
+        let occlusion = create(
+            vk::QueryType::OCCLUSION,
+            capacity,
+            vk::QueryPipelineStatisticFlags::empty(),
+        )?;
+        let bits = unsafe {
+            gpu.instance
+                .get_physical_device_queue_family_properties(gpu.physical)
+        }[gpu.queue_family as usize]
+            .timestamp_valid_bits;
+        let timestamp_mask = if bits >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << bits) - 1
+        };
+        Ok(Self {
+            capacity,
+            timestamps,
+            statistics,
+            occlusion,
+            precise_occlusion: gpu.features.precise_occlusion,
+            timestamp_mask,
+            ns_per_tick: gpu.properties.limits.timestamp_period as f64,
+            passes: Vec::new(),
+        })
+    }
+
+    /// Resets the pools and writes the frame's first timestamp.
+    pub fn begin_frame(&mut self, gpu: &Gpu, cmd: vk::CommandBuffer) {
+        self.passes.clear();
+        unsafe {
+            if let Some(pool) = self.timestamps {
+                gpu.device
+                    .cmd_reset_query_pool(cmd, pool, 0, self.capacity + 1);
+                gpu.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    pool,
+                    0,
+                );
+            }
+            if let Some(pool) = self.statistics {
+                gpu.device.cmd_reset_query_pool(cmd, pool, 0, self.capacity);
+            }
+            gpu.device
+                .cmd_reset_query_pool(cmd, self.occlusion, 0, self.capacity);
+        }
+    }
+
+    /// Records `body` as the pass `name`, surrounded by its queries and a debug
+    /// label, followed by its end-of-pass timestamp.
+    pub fn pass<R>(
+        &mut self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        name: &'static str,
+        kind: PassKind,
+        body: impl FnOnce() -> R,
+    ) -> R {
+        let index = self.passes.len() as u32;
+        assert!(
+            index < self.capacity,
+            "profiler capacity {} exceeded by pass {name}",
+            self.capacity
+        );
+        self.passes.push((name, kind));
+        let label = std::ffi::CString::new(name).unwrap_or_default();
+        unsafe {
+            if let Some(d) = &gpu.debug_device {
+                d.cmd_begin_debug_utils_label(
+                    cmd,
+                    &vk::DebugUtilsLabelEXT::default().label_name(&label),
+                );
+            }
+            if let Some(pool) = self.statistics {
+                gpu.device
+                    .cmd_begin_query(cmd, pool, index, vk::QueryControlFlags::empty());
+            }
+            if kind.graphics {
+                let flags = if self.precise_occlusion {
+                    vk::QueryControlFlags::PRECISE
+                } else {
+                    vk::QueryControlFlags::empty()
+                };
+                gpu.device
+                    .cmd_begin_query(cmd, self.occlusion, index, flags);
+            }
+        }
+        let result = body();
+        unsafe {
+            if kind.graphics {
+                gpu.device.cmd_end_query(cmd, self.occlusion, index);
+            }
+            if let Some(pool) = self.statistics {
+                gpu.device.cmd_end_query(cmd, pool, index);
+            }
+            if let Some(pool) = self.timestamps {
+                gpu.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    pool,
+                    index + 1,
+                );
+            }
+            if let Some(d) = &gpu.debug_device {
+                d.cmd_end_debug_utils_label(cmd);
+            }
+        }
+        result
+    }
+
+    /// Reads the last frame's queries. Call only after that frame's fence.
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<PassSample>> {
+        let n = self.passes.len();
+        let wait = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT;
+        let mut times = vec![0u64; n + 1];
+        if let Some(pool) = self.timestamps {
+            unsafe {
+                gpu.device
+                    .get_query_pool_results(pool, 0, &mut times, wait)?
+            };
+        }
+        let mut stats = vec![[0u64; 2]; n];
+        if let Some(pool) = self.statistics {
+            if n > 0 {
+                unsafe {
+                    gpu.device
+                        .get_query_pool_results(pool, 0, &mut stats, wait)?
+                };
+            }
+        }
+        let mut samples = vec![0u64; n];
+        for (i, (_, kind)) in self.passes.iter().enumerate() {
+            if kind.graphics {
+                unsafe {
+                    gpu.device.get_query_pool_results(
+                        self.occlusion,
+                        i as u32,
+                        &mut samples[i..i + 1],
+                        wait,
+                    )?
+                };
+            }
+        }
+        Ok(self
+            .passes
+            .iter()
+            .enumerate()
+            .map(|(i, &(name, kind))| {
+                let ticks = times[i + 1].wrapping_sub(times[i]) & self.timestamp_mask;
+                PassSample {
+                    name,
+                    kind,
+                    gpu_ms: self
+                        .timestamps
+                        .map(|_| ticks as f64 * self.ns_per_tick * 1e-6),
+                    fragment_invocations: self.statistics.map(|_| stats[i][0]),
+                    compute_invocations: self.statistics.map(|_| stats[i][1]),
+                    samples_passed: kind.graphics.then_some(samples[i]),
+                }
+            })
+            .collect())
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        unsafe {
+            if let Some(p) = self.timestamps.take() {
+                gpu.device.destroy_query_pool(p, None);
+            }
+            if let Some(p) = self.statistics.take() {
+                gpu.device.destroy_query_pool(p, None);
+            }
+            gpu.device.destroy_query_pool(self.occlusion, None);
+        }
+    }
+}

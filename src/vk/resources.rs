@@ -1,0 +1,276 @@
+//! Images and buffers backed by gpu-allocator. Owners call `destroy` explicitly
+//! (the renderer does so in its `Drop`), so no resource outlives its device.
+
+use super::Gpu;
+use anyhow::{Context as _, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+pub struct Image {
+    pub image: vk::Image,
+    /// A view of all layers (2D, or 2D array when `layers > 1`).
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub layers: u32,
+    pub aspect: vk::ImageAspectFlags,
+    allocation: Option<Allocation>,
+}
+
+#[derive(Clone, Copy)]
+pub struct ImageDesc<'a> {
+    pub name: &'a str,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub layers: u32,
+    pub usage: vk::ImageUsageFlags,
+}
+
+pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
+            vk::ImageAspectFlags::DEPTH
+        }
+        vk::Format::S8_UINT => vk::ImageAspectFlags::STENCIL,
+        vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT => {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        }
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+/// Bytes per texel of the formats `isr` reads back or budgets memory for.
+pub fn texel_bytes(format: vk::Format) -> u64 {
+    match format {
+        vk::Format::R32G32B32A32_SFLOAT => 16,
+        vk::Format::R16G16B16A16_SFLOAT => 8,
+        vk::Format::R32_SFLOAT | vk::Format::D32_SFLOAT => 4,
+        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB => 4,
+        vk::Format::S8_UINT => 1,
+        vk::Format::D32_SFLOAT_S8_UINT => 8,
+        vk::Format::D24_UNORM_S8_UINT => 4,
+        _ => 16,
+    }
+}
+
+impl Image {
+    pub fn new(gpu: &Gpu, desc: &ImageDesc) -> Result<Self> {
+        let aspect = aspect_of(desc.format);
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.extent.width,
+                height: desc.extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let image = unsafe { gpu.device.create_image(&info, None) }
+            .with_context(|| format!("creating image {}", desc.name))?;
+        let requirements = unsafe { gpu.device.get_image_memory_requirements(image) };
+        let allocation = gpu
+            .allocator
+            .lock()
+            .unwrap()
+            .allocate(&AllocationCreateDesc {
+                name: desc.name,
+                requirements,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .with_context(|| {
+                format!(
+                    "allocating {} MiB for image {} ({}x{}x{}); try a smaller resolution",
+                    requirements.size >> 20,
+                    desc.name,
+                    desc.extent.width,
+                    desc.extent.height,
+                    desc.layers
+                )
+            });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { gpu.device.destroy_image(image, None) };
+                return Err(e);
+            }
+        };
+        unsafe {
+            gpu.device
+                .bind_image_memory(image, allocation.memory(), allocation.offset())?
+        };
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view = unsafe {
+            gpu.device.create_image_view(
+                &vk::ImageViewCreateInfo::default()
+                    .image(image)
+                    .view_type(view_type)
+                    .format(desc.format)
+                    .subresource_range(full_range(aspect, desc.layers)),
+                None,
+            )
+        }?;
+        gpu.name(image, desc.name);
+        Ok(Self {
+            image,
+            view,
+            format: desc.format,
+            extent: desc.extent,
+            layers: desc.layers,
+            aspect,
+            allocation: Some(allocation),
+        })
+    }
+
+    pub fn range(&self) -> vk::ImageSubresourceRange {
+        full_range(self.aspect, self.layers)
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        if let Some(a) = self.allocation.take() {
+            unsafe {
+                gpu.device.destroy_image_view(self.view, None);
+                gpu.device.destroy_image(self.image, None);
+            }
+            let _ = gpu.allocator.lock().unwrap().free(a);
+        }
+    }
+}
+
+pub fn full_range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: layers,
+    }
+}
+
+pub struct Buffer {
+    pub buffer: vk::Buffer,
+    pub size: u64,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    pub fn new(
+        gpu: &Gpu,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self> {
+        let size = size.max(4);
+        let buffer = unsafe {
+            gpu.device.create_buffer(
+                &vk::BufferCreateInfo::default().size(size).usage(usage),
+                None,
+            )
+        }
+        .with_context(|| format!("creating buffer {name}"))?;
+        let requirements = unsafe { gpu.device.get_buffer_memory_requirements(buffer) };
+        let allocation = gpu
+            .allocator
+            .lock()
+            .unwrap()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .with_context(|| format!("allocating {} MiB for buffer {name}", size >> 20));
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { gpu.device.destroy_buffer(buffer, None) };
+                return Err(e);
+            }
+        };
+        unsafe {
+            gpu.device
+                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())?
+        };
+        gpu.name(buffer, name);
+        Ok(Self {
+            buffer,
+            size,
+            allocation: Some(allocation),
+        })
+    }
+
+    /// A device-local buffer filled with `data` through a staging copy.
+    pub fn with_data(
+        gpu: &Gpu,
+        name: &str,
+        data: &[u8],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self> {
+        let dst = Self::new(
+            gpu,
+            name,
+            data.len() as u64,
+            usage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        let mut staging = Self::new(
+            gpu,
+            &format!("{name} (staging)"),
+            data.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        staging.write(0, data);
+        let result = gpu.run_once(|cmd| unsafe {
+            gpu.device.cmd_copy_buffer(
+                cmd,
+                staging.buffer,
+                dst.buffer,
+                &[vk::BufferCopy::default().size(data.len().max(1) as u64)],
+            );
+            // The copy's writes become visible to every later shader or vertex read.
+            super::barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                vk::AccessFlags2::MEMORY_READ,
+            );
+        });
+        staging.destroy(gpu);
+        result.map(|_| dst)
+    }
+
+    /// Host-visible bytes (CpuToGpu and GpuToCpu buffers only).
+    pub fn mapped(&self) -> &[u8] {
+        let a = self.allocation.as_ref().expect("buffer was destroyed");
+        &a.mapped_slice().expect("buffer is not host-visible")[..self.size as usize]
+    }
+
+    pub fn write(&mut self, offset: usize, data: &[u8]) {
+        let a = self.allocation.as_mut().expect("buffer was destroyed");
+        let slice = a.mapped_slice_mut().expect("buffer is not host-visible");
+        slice[offset..offset + data.len()].copy_from_slice(data);
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        if let Some(a) = self.allocation.take() {
+            unsafe { gpu.device.destroy_buffer(self.buffer, None) };
+            let _ = gpu.allocator.lock().unwrap().free(a);
+        }
+    }
+}
