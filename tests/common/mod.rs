@@ -1,0 +1,124 @@
+//! Helpers shared by the integration tests. Tests that need Vulkan fail with a
+//! clear message when no device is found: they never skip, so a missing install
+//! step shows up in CI.
+#![allow(dead_code)]
+
+use glam::{DVec3, Vec3, Vec4};
+use isr::renderer::{FrameStats, Readback, RenderSettings, Renderer};
+use isr::scene::{Camera, Scene, SpotLight};
+use isr::vk::{Gpu, GpuOptions, Validation};
+
+/// A device with the validation layer loaded when it is installed.
+pub fn gpu() -> Gpu {
+    match Gpu::new(&GpuOptions {
+        validation: Validation::IfInstalled,
+        device_index: None,
+    }) {
+        Ok(g) => g,
+        Err(e) => panic!(
+            "this test needs a Vulkan device and found none usable: {e:#}\n\
+             Run `bash .ci/install-vulkan` (installs Mesa's lavapipe) and try again."
+        ),
+    }
+}
+
+/// Fails the test if the validation layer reported anything.
+pub fn assert_validation_clean(gpu: &Gpu) {
+    let messages = gpu.take_validation_messages();
+    assert!(
+        messages.is_empty(),
+        "the validation layer reported {} message(s):\n{}",
+        messages.len(),
+        messages.join("\n")
+    );
+}
+
+pub struct Rendered {
+    pub readback: Readback,
+    pub stats: FrameStats,
+    pub uniforms: isr::gpu_types::FrameUniforms,
+}
+
+/// Renders `frames` frames of `scene` and reads the results back, checking
+/// that validation stayed silent.
+pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) -> Rendered {
+    let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
+    let stats = r.render_frames(frames, |_| {}).expect("rendering");
+    let readback = r.readback().expect("readback");
+    let uniforms = *r.uniforms();
+    drop(r);
+    assert_validation_clean(gpu);
+    Rendered {
+        readback,
+        stats,
+        uniforms,
+    }
+}
+
+/// The pixel (x, y) where world point `p` lands, if it is on screen.
+pub fn project(
+    u: &isr::gpu_types::FrameUniforms,
+    width: u32,
+    height: u32,
+    p: Vec3,
+) -> Option<(u32, u32)> {
+    let m = glam::Mat4::from_cols_array_2d(&u.camera_view_proj);
+    let c = m * p.extend(1.0);
+    if c.w <= 0.0 {
+        return None;
+    }
+    let ndc = c.truncate() / c.w;
+    let x = ((ndc.x * 0.5 + 0.5) * width as f32).floor();
+    let y = ((ndc.y * 0.5 + 0.5) * height as f32).floor();
+    (x >= 0.0 && y >= 0.0 && x < width as f32 && y < height as f32).then_some((x as u32, y as u32))
+}
+
+/// A spot light at `position` aimed at `target`.
+pub fn spot(
+    position: Vec3,
+    target: Vec3,
+    intensity: f32,
+    inner_deg: f32,
+    outer_deg: f32,
+) -> SpotLight {
+    SpotLight {
+        position,
+        direction: (target - position).normalize(),
+        color: Vec3::ONE,
+        intensity,
+        inner_cone: inner_deg.to_radians(),
+        outer_cone: outer_deg.to_radians(),
+        range: None,
+    }
+}
+
+/// A scene with one horizontal square floor of half-size `half` at y = 0.
+pub fn floor_scene(light: SpotLight, camera: Camera, half: f32, albedo: f32) -> Scene {
+    let mut s = Scene::empty("floor", light, camera);
+    let m = s.add_material("floor", Vec3::splat(albedo));
+    let v = Vec3::new;
+    s.add_quad(
+        "floor",
+        [
+            v(-half, 0., half),
+            v(half, 0., half),
+            v(half, 0., -half),
+            v(-half, 0., -half),
+        ],
+        m,
+    );
+    s
+}
+
+/// The direct radiance ALGORITHM.md section 2 gives for an unshadowed
+/// Lambertian point: rho/pi * I(w) * max(0, n.l) / r^2, per channel, in f64.
+pub fn expected_direct(light: &SpotLight, albedo: Vec4, p: DVec3, n: DVec3) -> DVec3 {
+    let to_light = light.position.as_dvec3() - p;
+    let r2 = to_light.length_squared();
+    let cos = n.dot(to_light / r2.sqrt()).max(0.0);
+    albedo.truncate().as_dvec3() / std::f64::consts::PI * light.intensity_toward(p) * cos / r2
+}
+
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_isr"))
+}

@@ -1,0 +1,173 @@
+//! Per-pass timings and the validation layer over several frames.
+mod common;
+
+use common::*;
+use isr::renderer::RenderSettings;
+use isr::scene::cornell::cornell_box;
+
+const PASSES: [&str; 5] = ["rsm", "gbuffer", "direct", "composite", "tonemap"];
+
+#[test]
+fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
+    let gpu = gpu();
+    let settings = RenderSettings {
+        width: 128,
+        height: 128,
+        rsm_resolution: 128,
+        ..Default::default()
+    };
+    let out = render(&gpu, &cornell_box(), &settings, 4);
+    assert_eq!(out.stats.frames.len(), 4);
+    for (frame, wall) in out.stats.frames.iter().zip(&out.stats.wall_ms) {
+        let names: Vec<&str> = frame.iter().map(|p| p.name).collect();
+        assert_eq!(names, PASSES);
+        let mut sum = 0.0;
+        for p in frame {
+            let ms = p.gpu_ms.expect("lavapipe supports timestamps");
+            assert!(ms >= 0.0, "pass {} took {ms} ms", p.name);
+            sum += ms;
+            assert!(
+                p.fragment_invocations.is_some_and(|n| n > 0),
+                "pass {} has no fragment count",
+                p.name
+            );
+            assert!(
+                p.samples_passed.is_some_and(|n| n > 0),
+                "pass {} has no samples passed",
+                p.name
+            );
+        }
+        assert!(
+            sum <= *wall,
+            "passes sum to {sum} ms but the frame took {wall} ms of wall time"
+        );
+    }
+    // Full-screen passes shade every pixel exactly once.
+    let last = out.stats.frames.last().unwrap();
+    for p in last
+        .iter()
+        .filter(|p| ["direct", "composite", "tonemap"].contains(&p.name))
+    {
+        assert_eq!(p.samples_passed, Some(128 * 128), "pass {}", p.name);
+    }
+}
+
+#[test]
+fn timings_json_from_the_cli_lists_every_pass() {
+    let dir = std::env::temp_dir().join(format!("isr-timings-{}", std::process::id()));
+    let json = dir.join("t.json");
+    let out = bin()
+        .args([
+            "render", "--width", "96", "--height", "64", "--rsm", "64", "--frames", "3",
+        ])
+        .arg("--timings")
+        .arg(&json)
+        .arg("--out")
+        .arg(dir.join("r.exr"))
+        .arg("--png")
+        .arg(dir.join("r.png"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "isr render failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    for key in [
+        "device",
+        "driver",
+        "width",
+        "height",
+        "method",
+        "frames",
+        "passes",
+        "total_gpu_ms_median",
+        "indirect_gpu_ms_median",
+    ] {
+        assert!(v.get(key).is_some(), "timings JSON lacks {key}: {v}");
+    }
+    assert_eq!(v["width"], 96);
+    assert_eq!(v["frames"], 3);
+    let passes = v["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, PASSES);
+    let mut sum = 0.0;
+    for p in passes {
+        let med = p["gpu_ms_median"].as_f64().unwrap();
+        let min = p["gpu_ms_min"].as_f64().unwrap();
+        assert!(min >= 0.0 && min <= med, "{p}");
+        assert!(p["fragment_invocations"].as_u64().is_some(), "{p}");
+        sum += med;
+    }
+    assert!(sum > 0.0);
+    assert_eq!(
+        v["indirect_gpu_ms_median"].as_f64(),
+        Some(0.0),
+        "method none has no indirect passes"
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    for name in PASSES {
+        assert!(
+            table.contains(name),
+            "the printed table lacks {name}:\n{table}"
+        );
+    }
+    assert!(std::fs::metadata(dir.join("r.exr")).unwrap().len() > 0);
+    let png = image::open(dir.join("r.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (96, 64));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+fn validating_gpu() -> isr::vk::Gpu {
+    let result = isr::vk::Gpu::new(&isr::vk::GpuOptions {
+        validation: isr::vk::Validation::Required,
+        device_index: None,
+    });
+    result.unwrap_or_else(|e| {
+        panic!("{e:#}\nThis test needs the Khronos validation layer: run `bash .ci/install-vulkan --validation`.")
+    })
+}
+
+#[test]
+fn validation_with_synchronization_checks_is_silent_over_several_frames() {
+    let gpu = validating_gpu();
+    assert!(gpu.validating());
+    let settings = RenderSettings {
+        width: 160,
+        height: 120,
+        rsm_resolution: 128,
+        ..Default::default()
+    };
+    // `render` asserts that no message was reported (frames replay one command
+    // buffer, so frame 2 onwards checks the hazards between frames too).
+    render(&gpu, &cornell_box(), &settings, 3);
+}
+
+/// Silence is only evidence if the layer would speak: two unsynchronized
+/// writes to one buffer must be reported as a hazard.
+#[test]
+fn synchronization_validation_reports_a_real_hazard() {
+    use ash::vk;
+    let gpu = validating_gpu();
+    let buffer = isr::vk::Buffer::new(
+        &gpu,
+        "hazard",
+        256,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        gpu_allocator::MemoryLocation::GpuOnly,
+    )
+    .unwrap();
+    gpu.run_once(|cmd| unsafe {
+        gpu.device.cmd_fill_buffer(cmd, buffer.buffer, 0, 256, 1);
+        gpu.device.cmd_fill_buffer(cmd, buffer.buffer, 0, 256, 2);
+    })
+    .unwrap();
+    let mut buffer = buffer;
+    buffer.destroy(&gpu);
+    let messages = gpu.take_validation_messages();
+    assert!(
+        messages.iter().any(|m| m.contains("WRITE_AFTER_WRITE")),
+        "expected a WRITE_AFTER_WRITE hazard report, got: {messages:?}"
+    );
+}
