@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3};
 use serde_json::{json, Value};
 
 fn push_aligned(bin: &mut Vec<u8>, data: &[u8]) -> usize {
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let offset = bin.len();

@@ -15,7 +15,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Extensions whose absence would change what the file means, that `isr` reads.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual"];
 
 pub fn load(path: &Path) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| {
@@ -310,7 +310,7 @@ fn load_primitive(
     if let Some(&bad) = indices.iter().find(|&&i| i as usize >= n) {
         bail!("{label}: index {bad} is out of range for {n} vertices");
     }
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         bail!("{label}: {} indices is not a multiple of 3", indices.len());
     }
     let mut vertices: Vec<GpuVertex> = positions
@@ -451,7 +451,7 @@ fn read_light(l: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<SpotL
         ),
     };
     let half_pi = std::f32::consts::FRAC_PI_2;
-    if !(0.0..half_pi).contains(&inner) || !(outer > inner && outer <= half_pi) {
+    if !((0.0..half_pi).contains(&inner) && outer > inner && outer <= half_pi) {
         bail!(
             "light {}: cone angles must satisfy 0 <= inner < outer <= pi/2 (got {inner}, {outer})",
             l.index()

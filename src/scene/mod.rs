@@ -331,3 +331,53 @@ pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
         v.normal = n.normalize_or(Vec3::Y).to_array();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cuboid_faces_point_outward() {
+        let center = Vec3::new(0.3, 0.5, -0.2);
+        let (v, i) = cuboid(center, Vec3::new(0.6, 1.0, 0.4), 0.7);
+        for t in i.chunks_exact(3) {
+            let p = |k: usize| Vec3::from(v[t[k] as usize].position);
+            let n = (p(1) - p(0)).cross(p(2) - p(0));
+            assert!(n.dot(p(0) - center) > 0.0, "face winding points inward");
+            assert!(n
+                .normalize()
+                .abs_diff_eq(Vec3::from(v[t[0] as usize].normal), 1e-5));
+        }
+    }
+
+    #[test]
+    fn spot_attenuation_follows_khr_lights_punctual() {
+        let l = SpotLight {
+            position: Vec3::ZERO,
+            direction: -Vec3::Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            inner_cone: 0.3,
+            outer_cone: 0.6,
+            range: None,
+        };
+        assert_eq!(l.angular_attenuation(1.0), 1.0);
+        assert!((l.angular_attenuation(0.3f64.cos()) - 1.0).abs() < 1e-6);
+        assert_eq!(l.angular_attenuation(0.7f64.cos()), 0.0);
+        // Halfway in cosine between the cones: (1/2)^2.
+        let mid = 0.5 * (0.3f64.cos() + 0.6f64.cos());
+        assert!((l.angular_attenuation(mid) - 0.25).abs() < 1e-4);
+    }
+
+    #[test]
+    fn computed_normals_of_a_flat_quad_are_its_normal() {
+        let (mut v, i) = quad([Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, -1.0), -Vec3::Z]);
+        for x in &mut v {
+            x.normal = [0.0; 3];
+        }
+        compute_normals(&mut v, &i);
+        assert!(v
+            .iter()
+            .all(|x| Vec3::from(x.normal).abs_diff_eq(Vec3::Y, 1e-6)));
+    }
+}

@@ -1,0 +1,141 @@
+//! Host structs (`src/gpu_types.rs`) against the layouts glslang gave the
+//! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
+
+use isr::gpu_types::{DrawPush, FrameUniforms, MaterialGpu};
+use std::collections::HashMap;
+use std::mem::{offset_of, size_of};
+
+const OP_NAME: u32 = 5;
+const OP_MEMBER_NAME: u32 = 6;
+const OP_MEMBER_DECORATE: u32 = 72;
+const DECORATION_OFFSET: u32 = 35;
+
+fn string_at(words: &[u32]) -> String {
+    let bytes: Vec<u8> = words
+        .iter()
+        .flat_map(|w| w.to_le_bytes())
+        .take_while(|&b| b != 0)
+        .collect();
+    String::from_utf8(bytes).unwrap()
+}
+
+/// For every struct type named `name` in `shader`: member name -> byte offset.
+fn struct_layouts(shader: &str, name: &str) -> Vec<HashMap<String, u32>> {
+    let words = isr::vk::pipeline::spirv(shader).unwrap();
+    assert_eq!(words[0], 0x0723_0203, "not SPIR-V");
+    let mut names: HashMap<u32, String> = HashMap::new();
+    let mut member_names: HashMap<(u32, u32), String> = HashMap::new();
+    let mut offsets: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut i = 5;
+    while i < words.len() {
+        let (op, count) = (words[i] & 0xffff, (words[i] >> 16) as usize);
+        let ins = &words[i..i + count];
+        match op {
+            OP_NAME => {
+                names.insert(ins[1], string_at(&ins[2..]));
+            }
+            OP_MEMBER_NAME => {
+                member_names.insert((ins[1], ins[2]), string_at(&ins[3..]));
+            }
+            OP_MEMBER_DECORATE if ins[3] == DECORATION_OFFSET => {
+                offsets.insert((ins[1], ins[2]), ins[4]);
+            }
+            _ => {}
+        }
+        i += count;
+    }
+    let ids: Vec<u32> = names
+        .iter()
+        .filter(|(_, n)| *n == name)
+        .map(|(id, _)| *id)
+        .collect();
+    let layouts: Vec<HashMap<String, u32>> = ids
+        .iter()
+        .map(|id| {
+            offsets
+                .iter()
+                .filter(|((sid, _), _)| sid == id)
+                .map(|((sid, m), off)| (member_names[&(*sid, *m)].clone(), *off))
+                .collect::<HashMap<_, _>>()
+        })
+        .filter(|m| !m.is_empty())
+        .collect();
+    assert!(
+        !layouts.is_empty(),
+        "{shader} has no laid-out struct {name}"
+    );
+    layouts
+}
+
+macro_rules! check {
+    ($shader:expr, $ty:ident, $glsl:expr, $last:ident : $last_size:expr, [$($field:ident => $member:expr),* $(,)?]) => {
+        for layout in struct_layouts($shader, $glsl) {
+            $(
+                assert_eq!(
+                    layout.get($member).copied(),
+                    Some(offset_of!($ty, $field) as u32),
+                    "{}::{} vs GLSL {}.{} in {}", stringify!($ty), stringify!($field), $glsl, $member, $shader
+                );
+            )*
+            let glsl_size = layout[stringify!($last)] as usize + $last_size;
+            assert_eq!(size_of::<$ty>(), glsl_size, "size of {}", stringify!($ty));
+        }
+    };
+}
+
+#[test]
+fn frame_uniforms_match_shared_glsl() {
+    for shader in [
+        "rsm.frag",
+        "direct_light.frag",
+        "scene.vert",
+        "tonemap.frag",
+    ] {
+        check!(shader, FrameUniforms, "FrameUniforms", size: 16, [
+            camera_view_proj => "camera_view_proj",
+            light_view_proj => "light_view_proj",
+            camera_position => "camera_position",
+            camera_forward => "camera_forward",
+            light_position => "light_position",
+            light_direction => "light_direction",
+            light_intensity => "light_intensity",
+            light_cone => "light_cone",
+            shadow => "shadow",
+            exposure => "exposure",
+            size => "size",
+        ]);
+    }
+}
+
+#[test]
+fn material_matches_shared_glsl() {
+    check!("gbuffer.frag", MaterialGpu, "MaterialGpu", pad2: 4, [
+        base_color => "base_color",
+        texture => "texture",
+        pad => "pad0",
+    ]);
+}
+
+#[test]
+fn draw_push_matches_shared_glsl() {
+    check!("scene.vert", DrawPush, "DrawPush", pad2: 4, [
+        world_from_object => "world_from_object",
+        material => "material",
+        pad => "pad0",
+    ]);
+}
+
+#[test]
+fn every_shader_in_the_directory_is_embedded() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let embedded: Vec<&str> = isr::vk::pipeline::shader_names().collect();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if !name.ends_with(".glsl") {
+            assert!(
+                embedded.contains(&name.as_str()),
+                "{name} was not compiled into the binary"
+            );
+        }
+    }
+}
