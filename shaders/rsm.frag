@@ -14,8 +14,9 @@ layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 
-layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: 1 where geometry was seen
-layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: A_j (m^2)
+// The layout every level of the RSM quadtree shares (see rsm_tree.comp).
+layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: A_j (m^2), 0 where nothing was seen
+layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: 1 where geometry was seen
 layout(location = 2) out vec4 out_flux;      // rgb: Phi_j (W); a: dw_j (sr)
 
 // Smallest cosine used for A_j: a surface seen edge-on by the light would get an
@@ -37,7 +38,7 @@ void main() {
     float cos_j = max(dot(n, to_light * inversesqrt(r2)), MIN_COS_J);
     vec3 albedo = material_albedo(draw.material, in_uv);
 
-    out_position = vec4(in_world, 1.0);
-    out_normal = vec4(n, dw * r2 / cos_j);
+    out_position = vec4(in_world, dw * r2 / cos_j);
+    out_normal = vec4(n, 1.0);
     out_flux = vec4(albedo * spot_intensity(u, in_world) * dw, dw);
 }

@@ -19,7 +19,22 @@ struct FrameUniforms {
                             // z: PCF tap spacing (texels); w: slope bias (texels along the slope)
     vec4 exposure;          // x: multiplier applied before the PNG's sRGB encoding
     uvec4 size;             // x, y: output width, height; z: RSM resolution
+    vec4 refine;            // multiresolution buffer (ALGORITHM.md section 3): x: depth threshold
+                            // (relative depth range, (max - min) / min); y: normal threshold (chord
+                            // length |n_max - n_min| of the component box, 2 sin(angle / 2))
+    ivec4 hierarchy;        // x: coarsest level L; y: RSM quadtree level k of the VPLs;
+                            // z: VPLs per side sqrt(N); w: flags, see HIERARCHY_*
 };
+
+// hierarchy.w bits.
+const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
+const int HIERARCHY_INTERPOLATE = 2;   // interpolated (not nearest) upsampling
+const int HIERARCHY_STENCIL_OFF = 4;   // gather every texel, mask afterwards
+
+// Geometry-mip flag bits (image geo_flags).
+const uint GEO_HAS_GEOMETRY = 1u;  // at least one pixel of the texel sees geometry
+const uint GEO_SMOOTH = 2u;        // fully covered, depth range and normal spread under the thresholds
+const uint GEO_SPLIT = 4u;         // has geometry and is not a leaf: not smooth, or 2:1 balance
 
 // One glTF material (std430 storage buffer, set 0, binding 1 of scene passes).
 struct MaterialGpu {

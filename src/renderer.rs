@@ -94,14 +94,17 @@ const DEPTH_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
     vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
 );
 
+/// RSM images carry the RSM quadtree in their mip chain (level 0 = the RSM).
+const RSM_USAGE: vk::ImageUsageFlags =
+    vk::ImageUsageFlags::from_raw(COLOR_USAGE.as_raw() | vk::ImageUsageFlags::STORAGE.as_raw());
+
 /// (name, format, at RSM resolution, usage) of every target, in `Targets` order.
-fn target_list(s: &RenderSettings) -> Vec<(&'static str, vk::Format, bool, vk::ImageUsageFlags)> {
+fn target_list() -> Vec<(&'static str, vk::Format, bool, vk::ImageUsageFlags)> {
     use crate::passes::*;
-    let _ = s;
     vec![
-        ("rsm_position", rsm::FORMATS[0], true, COLOR_USAGE),
-        ("rsm_normal", rsm::FORMATS[1], true, COLOR_USAGE),
-        ("rsm_flux", rsm::FORMATS[2], true, COLOR_USAGE),
+        ("rsm_position", rsm::FORMATS[0], true, RSM_USAGE),
+        ("rsm_normal", rsm::FORMATS[1], true, RSM_USAGE),
+        ("rsm_flux", rsm::FORMATS[2], true, RSM_USAGE),
         ("rsm_depth", vk::Format::D32_SFLOAT, true, DEPTH_USAGE),
         ("gbuffer_position", gbuffer::FORMATS[0], false, COLOR_USAGE),
         ("gbuffer_normal", gbuffer::FORMATS[1], false, COLOR_USAGE),
@@ -124,7 +127,12 @@ fn target_list(s: &RenderSettings) -> Vec<(&'static str, vk::Format, bool, vk::I
 impl Targets {
     fn new(gpu: &Gpu, s: &RenderSettings) -> Result<Self> {
         let mut images = Vec::new();
-        for (name, format, rsm, usage) in target_list(s) {
+        for (name, format, rsm, usage) in target_list() {
+            let mips = if rsm && format != vk::Format::D32_SFLOAT {
+                s.rsm_resolution.ilog2() + 1
+            } else {
+                1
+            };
             let extent = if rsm {
                 vk::Extent2D {
                     width: s.rsm_resolution,
@@ -143,6 +151,7 @@ impl Targets {
                     format,
                     extent,
                     layers: 1,
+                    mips,
                     usage,
                 },
             ) {
@@ -348,6 +357,13 @@ impl SceneGpu {
             slice_bytes(&materials),
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
+        if textures.len() > 1 && !gpu.features.sampled_image_array_indexing {
+            bail!(
+                "the scene has {} textures, but this device cannot index texture arrays \
+                 (shaderSampledImageArrayDynamicIndexing); use a scene with at most one texture",
+                textures.len()
+            );
+        }
         let views: Vec<vk::ImageView> = textures.iter().map(|t| t.view).collect();
         let set = DescriptorSet::new(
             gpu,
@@ -395,16 +411,15 @@ fn upload_texture(gpu: &Gpu, t: &crate::scene::Texture) -> Result<Image> {
     }
     let image = Image::new(
         gpu,
-        &ImageDesc {
-            name: &t.name,
-            format: vk::Format::R8G8B8A8_SRGB,
-            extent: vk::Extent2D {
+        &ImageDesc::flat(
+            &t.name,
+            vk::Format::R8G8B8A8_SRGB,
+            vk::Extent2D {
                 width: t.width,
                 height: t.height,
             },
-            layers: 1,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-        },
+            vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        ),
     )?;
     let mut staging = Buffer::new(
         gpu,
@@ -473,9 +488,9 @@ pub struct Readback {
 
 pub struct RsmReadback {
     pub resolution: u32,
-    /// xyz position, w 1 where geometry was seen.
+    /// xyz position, w area A_j (0 where nothing was seen).
     pub position: Vec<[f32; 4]>,
-    /// xyz normal, w area A_j.
+    /// xyz normal, w 1 where geometry was seen.
     pub normal: Vec<[f32; 4]>,
     /// rgb flux Phi_j, a solid angle dw_j.
     pub flux: Vec<[f32; 4]>,
@@ -531,7 +546,7 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
             max_w.min(max_h)
         );
     }
-    let needed: u64 = target_list(s)
+    let needed: u64 = target_list()
         .iter()
         .map(|(_, f, rsm, _)| {
             let texels = if *rsm { (r as u64).pow(2) } else { s.width as u64 * s.height as u64 };

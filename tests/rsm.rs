@@ -44,7 +44,7 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
     };
     let rsm = render(&gpu, &scene, &settings, 1).readback.rsm;
     assert!(
-        rsm.position.iter().all(|p| p[3] == 1.0),
+        rsm.normal.iter().all(|n| n[3] == 1.0),
         "some RSM texels saw no geometry"
     );
 
@@ -67,7 +67,7 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
     );
 
     // Areas: the texels tile the floor's square under the frustum, (2 h tan a)^2.
-    let area: f64 = rsm.normal.iter().map(|n| n[3] as f64).sum();
+    let area: f64 = rsm.position.iter().map(|p| p[3] as f64).sum();
     let area_expected = (2.0 * height as f64 * a.tan()).powi(2);
     assert!(
         (area - area_expected).abs() < 0.01 * area_expected,

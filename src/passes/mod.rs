@@ -32,21 +32,50 @@ pub const GRAPHICS: PassKind = PassKind {
     indirect: false,
 };
 
-/// Starts dynamic rendering into `colors` (cleared to zero) and `depth`
-/// (cleared to 0, the far plane of reversed-Z), and sets viewport and scissor
-/// to the attachments' extent.
-pub fn begin_rendering(
-    gpu: &Gpu,
-    cmd: vk::CommandBuffer,
-    colors: &[&Image],
-    depth: Option<&Image>,
-) {
-    let extent = colors.first().or(depth.as_ref()).map(|i| i.extent).unwrap();
-    let color_attachments: Vec<_> = colors
+/// What a render-pass instance draws into. Colors are cleared to zero, depth
+/// to 0 (the far plane of reversed-Z); the stencil is cleared to 0 or kept.
+pub struct Attachments<'a> {
+    pub extent: vk::Extent2D,
+    /// Layers of layered rendering (`gl_Layer`); 1 otherwise.
+    pub layers: u32,
+    pub colors: &'a [vk::ImageView],
+    pub depth: Option<vk::ImageView>,
+    pub stencil: Option<StencilAttachment>,
+}
+
+#[derive(Clone, Copy)]
+pub struct StencilAttachment {
+    pub view: vk::ImageView,
+    /// Clear to 0 (and write), or keep the contents read-only.
+    pub clear: bool,
+}
+
+impl<'a> Attachments<'a> {
+    /// Single-layer color targets plus an optional depth buffer.
+    pub fn simple(
+        colors: &'a [vk::ImageView],
+        depth: Option<vk::ImageView>,
+        extent: vk::Extent2D,
+    ) -> Self {
+        Self {
+            extent,
+            layers: 1,
+            colors,
+            depth,
+            stencil: None,
+        }
+    }
+}
+
+/// Starts dynamic rendering into `a` and sets viewport and scissor to its extent.
+pub fn begin_rendering(gpu: &Gpu, cmd: vk::CommandBuffer, a: &Attachments) {
+    let extent = a.extent;
+    let color_attachments: Vec<_> = a
+        .colors
         .iter()
-        .map(|img| {
+        .map(|view| {
             vk::RenderingAttachmentInfo::default()
-                .image_view(img.view)
+                .image_view(*view)
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
@@ -55,18 +84,32 @@ pub fn begin_rendering(
                 })
         })
         .collect();
-    let depth_attachment = depth.map(|d| {
+    let depth_stencil_clear = vk::ClearValue {
+        depth_stencil: vk::ClearDepthStencilValue {
+            depth: 0.0,
+            stencil: 0,
+        },
+    };
+    let depth_attachment = a.depth.map(|view| {
         vk::RenderingAttachmentInfo::default()
-            .image_view(d.view)
+            .image_view(view)
             .image_layout(vk::ImageLayout::ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 0.0,
-                    stencil: 0,
-                },
-            })
+            .clear_value(depth_stencil_clear)
+    });
+    let stencil_attachment = a.stencil.map(|s| {
+        let info = vk::RenderingAttachmentInfo::default().image_view(s.view);
+        if s.clear {
+            info.image_layout(vk::ImageLayout::ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(depth_stencil_clear)
+        } else {
+            info.image_layout(vk::ImageLayout::READ_ONLY_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::LOAD)
+                .store_op(vk::AttachmentStoreOp::NONE)
+        }
     });
     let area = vk::Rect2D {
         offset: vk::Offset2D::default(),
@@ -74,10 +117,13 @@ pub fn begin_rendering(
     };
     let mut info = vk::RenderingInfo::default()
         .render_area(area)
-        .layer_count(1)
+        .layer_count(a.layers)
         .color_attachments(&color_attachments);
     if let Some(d) = &depth_attachment {
         info = info.depth_attachment(d);
+    }
+    if let Some(s) = &stencil_attachment {
+        info = info.stencil_attachment(s);
     }
     unsafe {
         gpu.device.cmd_begin_rendering(cmd, &info);
@@ -126,6 +172,7 @@ impl ScenePass {
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
                 specialization: &[(0, scene.texture_count() as i32), (1, from_light as i32)],
+                ..Default::default()
             },
         )?;
         Ok(Self { pipeline })
@@ -152,7 +199,12 @@ impl ScenePass {
         ));
         barrier::images(gpu, cmd, &before);
 
-        begin_rendering(gpu, cmd, colors, Some(depth));
+        let views: Vec<_> = colors.iter().map(|c| c.mip_views[0]).collect();
+        begin_rendering(
+            gpu,
+            cmd,
+            &Attachments::simple(&views, Some(depth.view), depth.extent),
+        );
         let d = &gpu.device;
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
@@ -229,13 +281,8 @@ impl FullscreenPass {
                 vertex_shader: "fullscreen.vert",
                 fragment_shader,
                 set_layouts: &[set.layout],
-                push_constant_bytes: 0,
-                scene_vertices: false,
                 color_formats,
-                depth_format: vk::Format::UNDEFINED,
-                depth_test: None,
-                dynamic_cull: false,
-                specialization: &[],
+                ..Default::default()
             },
         )?;
         Ok(Self { pipeline, set })
@@ -250,7 +297,12 @@ impl FullscreenPass {
             Use::DISCARD_AFTER_READERS,
             Use::COLOR_ATTACHMENT,
         );
-        begin_rendering(gpu, cmd, outputs, None);
+        let views: Vec<_> = outputs.iter().map(|o| o.view).collect();
+        begin_rendering(
+            gpu,
+            cmd,
+            &Attachments::simple(&views, None, outputs[0].extent),
+        );
         let d = &gpu.device;
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);

@@ -58,6 +58,24 @@ impl Use {
         ),
         layout: vk::ImageLayout::ATTACHMENT_OPTIMAL,
     };
+    /// Storage-image reads and writes by compute shaders.
+    pub const COMPUTE_STORAGE: Use = Use {
+        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+                | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+        ),
+        layout: vk::ImageLayout::GENERAL,
+    };
+    /// Storage-image reads and writes by fragment shaders.
+    pub const FRAGMENT_STORAGE: Use = Use {
+        stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+                | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+        ),
+        layout: vk::ImageLayout::GENERAL,
+    };
     pub const TRANSFER_DST: Use = Use {
         stage: vk::PipelineStageFlags2::from_raw(
             vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::CLEAR.as_raw(),
@@ -79,6 +97,17 @@ impl Use {
 }
 
 pub fn image(image: &Image, from: Use, to: Use) -> vk::ImageMemoryBarrier2<'static> {
+    mips(image, 0, image.mips, from, to)
+}
+
+/// A barrier for `count` mip levels of `image` starting at `base`.
+pub fn mips(
+    image: &Image,
+    base: u32,
+    count: u32,
+    from: Use,
+    to: Use,
+) -> vk::ImageMemoryBarrier2<'static> {
     vk::ImageMemoryBarrier2::default()
         .src_stage_mask(from.stage)
         .src_access_mask(from.access)
@@ -89,7 +118,7 @@ pub fn image(image: &Image, from: Use, to: Use) -> vk::ImageMemoryBarrier2<'stat
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image.image)
-        .subresource_range(image.range())
+        .subresource_range(image.mip_range(base, count))
 }
 
 /// Records one `vkCmdPipelineBarrier2` for `barriers`.

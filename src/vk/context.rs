@@ -74,6 +74,12 @@ pub struct OptionalFeatures {
     pub precise_occlusion: bool,
     /// `timestampValidBits > 0` on the queue and `timestampComputeAndGraphics`.
     pub timestamps: bool,
+    /// `gl_Layer` written by vertex shaders (layered multiresolution passes).
+    pub shader_output_layer: bool,
+    /// Atomics in fragment shaders (patch counts).
+    pub fragment_atomics: bool,
+    /// Indexing the scene's texture array with a per-draw index.
+    pub sampled_image_array_indexing: bool,
 }
 
 /// Messages the validation layer reported, collected so that tests can fail on them.
@@ -368,16 +374,27 @@ impl Gpu {
             unsafe { instance.get_physical_device_queue_family_properties(physical) }
                 [queue_family as usize];
 
-        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
+        let mut supported2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
+        unsafe { instance.get_physical_device_features2(physical, &mut supported2) };
+        let supported = supported2.features;
         let features = OptionalFeatures {
             pipeline_statistics: supported.pipeline_statistics_query == vk::TRUE,
             precise_occlusion: supported.occlusion_query_precise == vk::TRUE,
             timestamps: family_props.timestamp_valid_bits > 0
                 && properties.limits.timestamp_compute_and_graphics == vk::TRUE,
+            shader_output_layer: supported12.shader_output_layer == vk::TRUE,
+            fragment_atomics: supported.fragment_stores_and_atomics == vk::TRUE,
+            sampled_image_array_indexing: supported.shader_sampled_image_array_dynamic_indexing
+                == vk::TRUE,
         };
         let enabled = vk::PhysicalDeviceFeatures::default()
             .pipeline_statistics_query(features.pipeline_statistics)
-            .occlusion_query_precise(features.precise_occlusion);
+            .occlusion_query_precise(features.precise_occlusion)
+            .fragment_stores_and_atomics(features.fragment_atomics)
+            .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing);
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
+            .shader_output_layer(features.shader_output_layer);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
             .synchronization2(true);
@@ -388,7 +405,8 @@ impl Gpu {
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_features(&enabled)
-            .push_next(&mut f13);
+            .push_next(&mut f13)
+            .push_next(&mut f12);
         let device = unsafe { instance.create_device(physical, &device_info, None) }
             .with_context(|| format!("creating a Vulkan device on {}", info.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -444,6 +462,21 @@ impl Gpu {
             .as_ref()
             .map(|l| l.take())
             .unwrap_or_default()
+    }
+
+    /// The first of `candidates` whose optimal tiling supports `features`.
+    pub fn pick_format(
+        &self,
+        candidates: &[vk::Format],
+        features: vk::FormatFeatureFlags,
+    ) -> Option<vk::Format> {
+        candidates.iter().copied().find(|&f| {
+            let p = unsafe {
+                self.instance
+                    .get_physical_device_format_properties(self.physical, f)
+            };
+            p.optimal_tiling_features.contains(features)
+        })
     }
 
     pub fn limits(&self) -> &vk::PhysicalDeviceLimits {

@@ -24,6 +24,24 @@ pub fn shader_names() -> impl Iterator<Item = &'static str> {
     embedded::SPIRV.iter().map(|(n, _)| *n)
 }
 
+/// Map entries and data for 32-bit integer (or bool) specialization constants.
+fn specialization_data(constants: &[(u32, i32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
+    let entries = constants
+        .iter()
+        .enumerate()
+        .map(|(i, (id, _))| vk::SpecializationMapEntry {
+            constant_id: *id,
+            offset: (i * 4) as u32,
+            size: 4,
+        })
+        .collect();
+    let data = constants
+        .iter()
+        .flat_map(|(_, v)| v.to_ne_bytes())
+        .collect();
+    (entries, data)
+}
+
 fn shader_module(gpu: &Gpu, name: &str) -> Result<vk::ShaderModule> {
     let code = spirv(name)?;
     let module = unsafe {
@@ -44,6 +62,8 @@ pub enum Binding<'a> {
     Sampled(vk::ImageView, vk::Sampler),
     /// An array of combined image samplers.
     SampledArray(&'a [vk::ImageView], vk::Sampler),
+    /// A storage image in `GENERAL` layout.
+    StorageImage(vk::ImageView),
 }
 
 /// A descriptor set layout, its pool and the one set allocated from it.
@@ -58,6 +78,7 @@ impl DescriptorSet {
     pub fn new(gpu: &Gpu, name: &str, bindings: &[Binding]) -> Result<Self> {
         let stages = vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE;
         let kind = |b: &Binding| match b {
+            Binding::StorageImage(_) => (vk::DescriptorType::STORAGE_IMAGE, 1),
             Binding::Uniform(_) => (vk::DescriptorType::UNIFORM_BUFFER, 1),
             Binding::Storage(_) => (vk::DescriptorType::STORAGE_BUFFER, 1),
             Binding::Sampled(..) => (vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
@@ -129,6 +150,11 @@ impl DescriptorSet {
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 };
                 match b {
+                    Binding::StorageImage(view) => vec![vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: *view,
+                        image_layout: vk::ImageLayout::GENERAL,
+                    }],
                     Binding::Sampled(view, sampler) => vec![info(*view, *sampler)],
                     Binding::SampledArray(views, sampler) => {
                         views.iter().map(|v| info(*v, *sampler)).collect()
@@ -182,10 +208,57 @@ pub struct GraphicsDesc<'a> {
     pub depth_format: vk::Format,
     /// Depth test with this compare op and depth writes; `None` disables both.
     pub depth_test: Option<vk::CompareOp>,
+    /// A stencil attachment of this format with this test (`UNDEFINED`: none).
+    pub stencil_format: vk::Format,
+    pub stencil: Option<StencilTest>,
+    /// Additive blending (`ONE + ONE`) on every color attachment.
+    pub additive: bool,
     /// Cull mode is set per draw (glTF `doubleSided`), so it is dynamic state.
     pub dynamic_cull: bool,
     /// Integer specialization constants, by constant id.
     pub specialization: &'a [(u32, i32)],
+}
+
+impl Default for GraphicsDesc<'_> {
+    fn default() -> Self {
+        Self {
+            name: "",
+            vertex_shader: "fullscreen.vert",
+            fragment_shader: "",
+            set_layouts: &[],
+            push_constant_bytes: 0,
+            scene_vertices: false,
+            color_formats: &[],
+            depth_format: vk::Format::UNDEFINED,
+            depth_test: None,
+            stencil_format: vk::Format::UNDEFINED,
+            stencil: None,
+            additive: false,
+            dynamic_cull: false,
+            specialization: &[],
+        }
+    }
+}
+
+/// Stencil state for front and back faces alike; the reference is 1.
+#[derive(Clone, Copy, Debug)]
+pub struct StencilTest {
+    pub compare: vk::CompareOp,
+    /// Operation when the stencil (and depth) test passes; `KEEP` for read-only.
+    pub pass_op: vk::StencilOp,
+}
+
+impl StencilTest {
+    /// Texels where stencil == 1, read-only.
+    pub const EQUAL_ONE: StencilTest = StencilTest {
+        compare: vk::CompareOp::EQUAL,
+        pass_op: vk::StencilOp::KEEP,
+    };
+    /// Writes 1 wherever the fragment survives (is not discarded).
+    pub const WRITE_ONE: StencilTest = StencilTest {
+        compare: vk::CompareOp::ALWAYS,
+        pass_op: vk::StencilOp::REPLACE,
+    };
 }
 
 pub struct Pipeline {
@@ -208,21 +281,7 @@ impl Pipeline {
 
         let vs = shader_module(gpu, desc.vertex_shader)?;
         let fs = shader_module(gpu, desc.fragment_shader)?;
-        let spec_entries: Vec<_> = desc
-            .specialization
-            .iter()
-            .enumerate()
-            .map(|(i, (id, _))| vk::SpecializationMapEntry {
-                constant_id: *id,
-                offset: (i * 4) as u32,
-                size: 4,
-            })
-            .collect();
-        let spec_data: Vec<u8> = desc
-            .specialization
-            .iter()
-            .flat_map(|(_, v)| v.to_ne_bytes())
-            .collect();
+        let (spec_entries, spec_data) = specialization_data(desc.specialization);
         let spec = vk::SpecializationInfo::default()
             .map_entries(&spec_entries)
             .data(&spec_data);
@@ -263,16 +322,40 @@ impl Pipeline {
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let stencil_op = desc.stencil.map(|t| {
+            vk::StencilOpState::default()
+                .fail_op(vk::StencilOp::KEEP)
+                .depth_fail_op(vk::StencilOp::KEEP)
+                .pass_op(t.pass_op)
+                .compare_op(t.compare)
+                .compare_mask(0xff)
+                .write_mask(0xff)
+                .reference(1)
+        });
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_test.is_some())
             .depth_write_enable(desc.depth_test.is_some())
-            .depth_compare_op(desc.depth_test.unwrap_or(vk::CompareOp::ALWAYS));
+            .depth_compare_op(desc.depth_test.unwrap_or(vk::CompareOp::ALWAYS))
+            .stencil_test_enable(stencil_op.is_some())
+            .front(stencil_op.unwrap_or_default())
+            .back(stencil_op.unwrap_or_default());
         let blend_attachments: Vec<_> = desc
             .color_formats
             .iter()
             .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+                let b = vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA);
+                if desc.additive {
+                    b.blend_enable(true)
+                        .src_color_blend_factor(vk::BlendFactor::ONE)
+                        .dst_color_blend_factor(vk::BlendFactor::ONE)
+                        .color_blend_op(vk::BlendOp::ADD)
+                        .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                        .alpha_blend_op(vk::BlendOp::ADD)
+                } else {
+                    b
+                }
             })
             .collect();
         let blend =
@@ -286,7 +369,8 @@ impl Pipeline {
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(desc.color_formats)
-            .depth_attachment_format(desc.depth_format);
+            .depth_attachment_format(desc.depth_format)
+            .stencil_attachment_format(desc.stencil_format);
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)
             .vertex_input_state(&vertex_input)
@@ -309,6 +393,48 @@ impl Pipeline {
         }
         let pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {}: {e}", desc.name))?[0];
         gpu.name(pipeline, desc.name);
+        Ok(Self { pipeline, layout })
+    }
+
+    /// A compute pipeline running `shader` (entry `main`).
+    pub fn compute(
+        gpu: &Gpu,
+        name: &str,
+        shader: &str,
+        set_layouts: &[vk::DescriptorSetLayout],
+        push_constant_bytes: u32,
+        specialization: &[(u32, i32)],
+    ) -> Result<Self> {
+        let push = [vk::PushConstantRange {
+            stage_flags: vk::ShaderStageFlags::COMPUTE,
+            offset: 0,
+            size: push_constant_bytes,
+        }];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(set_layouts);
+        if push_constant_bytes > 0 {
+            layout_info = layout_info.push_constant_ranges(&push);
+        }
+        let layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }?;
+        let module = shader_module(gpu, shader)?;
+        let (spec_entries, spec_data) = specialization_data(specialization);
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&spec_entries)
+            .data(&spec_data);
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main")
+            .specialization_info(&spec);
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        let result = unsafe {
+            gpu.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        unsafe { gpu.device.destroy_shader_module(module, None) };
+        let pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {name}: {e}"))?[0];
+        gpu.name(pipeline, name);
         Ok(Self { pipeline, layout })
     }
 

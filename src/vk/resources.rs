@@ -9,11 +9,15 @@ use gpu_allocator::MemoryLocation;
 
 pub struct Image {
     pub image: vk::Image,
-    /// A view of all layers (2D, or 2D array when `layers > 1`).
+    /// A view of all mips and layers (2D, or 2D array when `layers > 1`).
     pub view: vk::ImageView,
+    /// One view per mip level (all layers), for storage writes and attachments.
+    pub mip_views: Vec<vk::ImageView>,
     pub format: vk::Format,
+    /// Extent of mip 0.
     pub extent: vk::Extent2D,
     pub layers: u32,
+    pub mips: u32,
     pub aspect: vk::ImageAspectFlags,
     allocation: Option<Allocation>,
 }
@@ -24,7 +28,27 @@ pub struct ImageDesc<'a> {
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     pub layers: u32,
+    pub mips: u32,
     pub usage: vk::ImageUsageFlags,
+}
+
+impl<'a> ImageDesc<'a> {
+    /// A single-layer, single-mip image.
+    pub fn flat(
+        name: &'a str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+    ) -> Self {
+        Self {
+            name,
+            format,
+            extent,
+            layers: 1,
+            mips: 1,
+            usage,
+        }
+    }
 }
 
 pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
@@ -48,6 +72,7 @@ pub fn texel_bytes(format: vk::Format) -> u64 {
         vk::Format::R32_SFLOAT | vk::Format::D32_SFLOAT => 4,
         vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB => 4,
         vk::Format::S8_UINT => 1,
+        vk::Format::R32_UINT => 4,
         vk::Format::D32_SFLOAT_S8_UINT => 8,
         vk::Format::D24_UNORM_S8_UINT => 4,
         _ => 16,
@@ -65,7 +90,7 @@ impl Image {
                 height: desc.extent.height,
                 depth: 1,
             })
-            .mip_levels(1)
+            .mip_levels(desc.mips)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -111,50 +136,84 @@ impl Image {
         } else {
             vk::ImageViewType::TYPE_2D
         };
-        let view = unsafe {
-            gpu.device.create_image_view(
-                &vk::ImageViewCreateInfo::default()
-                    .image(image)
-                    .view_type(view_type)
-                    .format(desc.format)
-                    .subresource_range(full_range(aspect, desc.layers)),
-                None,
-            )
-        }?;
+        let make_view = |base_mip: u32, mips: u32| {
+            let range = vk::ImageSubresourceRange {
+                aspect_mask: aspect,
+                base_mip_level: base_mip,
+                level_count: mips,
+                base_array_layer: 0,
+                layer_count: desc.layers,
+            };
+            unsafe {
+                gpu.device.create_image_view(
+                    &vk::ImageViewCreateInfo::default()
+                        .image(image)
+                        .view_type(view_type)
+                        .format(desc.format)
+                        .subresource_range(range),
+                    None,
+                )
+            }
+        };
+        let view = make_view(0, desc.mips)?;
+        let mip_views = if desc.mips > 1 {
+            (0..desc.mips)
+                .map(|m| make_view(m, 1))
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            vec![view]
+        };
         gpu.name(image, desc.name);
         Ok(Self {
             image,
             view,
+            mip_views,
             format: desc.format,
             extent: desc.extent,
             layers: desc.layers,
+            mips: desc.mips,
             aspect,
             allocation: Some(allocation),
         })
     }
 
+    /// Every mip and layer.
     pub fn range(&self) -> vk::ImageSubresourceRange {
-        full_range(self.aspect, self.layers)
+        self.mip_range(0, self.mips)
+    }
+
+    /// `count` mips from `base`, all layers.
+    pub fn mip_range(&self, base: u32, count: u32) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange {
+            aspect_mask: self.aspect,
+            base_mip_level: base,
+            level_count: count,
+            base_array_layer: 0,
+            layer_count: self.layers,
+        }
+    }
+
+    /// Extent of mip `m`.
+    pub fn mip_extent(&self, m: u32) -> vk::Extent2D {
+        vk::Extent2D {
+            width: (self.extent.width >> m).max(1),
+            height: (self.extent.height >> m).max(1),
+        }
     }
 
     pub fn destroy(&mut self, gpu: &Gpu) {
         if let Some(a) = self.allocation.take() {
             unsafe {
+                if self.mips > 1 {
+                    for v in &self.mip_views {
+                        gpu.device.destroy_image_view(*v, None);
+                    }
+                }
                 gpu.device.destroy_image_view(self.view, None);
                 gpu.device.destroy_image(self.image, None);
             }
             let _ = gpu.allocator.lock().unwrap().free(a);
         }
-    }
-}
-
-pub fn full_range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::ImageSubresourceRange {
-    vk::ImageSubresourceRange {
-        aspect_mask: aspect,
-        base_mip_level: 0,
-        level_count: 1,
-        base_array_layer: 0,
-        layer_count: layers,
     }
 }
 

@@ -1,0 +1,126 @@
+#version 460
+// One level of the geometry mipmaps (ALGORITHM.md section 3, steps 2-4).
+// Level 0 reads the G-buffer; level l > 0 merges 2x2 texels of level l - 1.
+// Per texel: mean position and view depth, mean normal and coverage, the
+// depth and normal-component ranges, and the flags smooth / split.
+//
+// Discontinuities on texel borders: level 0's ranges are taken over the 3x3
+// pixel neighbourhood, so every coarser texel's range covers its footprint
+// plus a one-pixel ring and an edge lying exactly on a border is seen by the
+// texels on both sides.
+//
+// 2:1 balance: a texel splits if it is not smooth, or if any texel of level
+// l - 1 in the 4x4 block around its children (its children and the ring of
+// their neighbours) splits. So no leaf is adjacent to a leaf two levels finer.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(set = 0, binding = 1) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
+layout(set = 0, binding = 2) uniform sampler2D gbuffer_normal;
+// Level l - 1 (unused at level 0).
+layout(set = 0, binding = 3, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
+layout(set = 0, binding = 5, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
+layout(set = 0, binding = 6, rgba32f) readonly uniform image2D src_max;     // x: max depth; yzw: max normal components
+layout(set = 0, binding = 7, r32ui) readonly uniform uimage2D src_flags;
+// Level l.
+layout(set = 0, binding = 8, rgba32f) writeonly uniform image2D dst_mean;
+layout(set = 0, binding = 9, rgba32f) writeonly uniform image2D dst_normal;
+layout(set = 0, binding = 10, rgba32f) writeonly uniform image2D dst_min;
+layout(set = 0, binding = 11, rgba32f) writeonly uniform image2D dst_max;
+layout(set = 0, binding = 12, r32ui) writeonly uniform uimage2D dst_flags;
+
+layout(push_constant) uniform Push { int level; };
+
+const float BIG = 3.0e38;
+
+bool smooth_ranges(vec4 lo, vec4 hi) {
+    bool depth_ok = (hi.x - lo.x) < u.refine.x * lo.x;
+    bool normal_ok = length(hi.yzw - lo.yzw) < u.refine.y;
+    return depth_ok && normal_ok;
+}
+
+void level_zero(ivec2 p) {
+    vec4 pos = texelFetch(gbuffer_position, p, 0);
+    if (pos.w <= 0.0) {
+        imageStore(dst_mean, p, vec4(0.0));
+        imageStore(dst_normal, p, vec4(0.0));
+        imageStore(dst_min, p, vec4(BIG));
+        imageStore(dst_max, p, vec4(-BIG));
+        imageStore(dst_flags, p, uvec4(0u));
+        return;
+    }
+    vec3 n = texelFetch(gbuffer_normal, p, 0).xyz;
+    vec4 lo = vec4(BIG), hi = vec4(-BIG);
+    ivec2 size = ivec2(u.size.xy);
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = p + ivec2(dx, dy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+            vec4 qp = texelFetch(gbuffer_position, q, 0);
+            if (qp.w <= 0.0) continue;
+            vec4 v = vec4(qp.w, texelFetch(gbuffer_normal, q, 0).xyz);
+            lo = min(lo, v);
+            hi = max(hi, v);
+        }
+    }
+    imageStore(dst_mean, p, pos);
+    imageStore(dst_normal, p, vec4(n, 1.0));
+    imageStore(dst_min, p, lo);
+    imageStore(dst_max, p, hi);
+    imageStore(dst_flags, p, uvec4(GEO_HAS_GEOMETRY | GEO_SMOOTH));  // level 0 is always smooth
+}
+
+void coarser_level(ivec2 p) {
+    vec4 mean = vec4(0.0);
+    vec3 normal = vec3(0.0);
+    float coverage = 0.0;
+    vec4 lo = vec4(BIG), hi = vec4(-BIG);
+    for (int i = 0; i < 4; ++i) {
+        ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
+        vec4 cn = imageLoad(src_normal, c);
+        mean += cn.w * imageLoad(src_mean, c);
+        normal += cn.w * cn.xyz;
+        coverage += cn.w;
+        lo = min(lo, imageLoad(src_min, c));
+        hi = max(hi, imageLoad(src_max, c));
+    }
+    uint flags = 0u;
+    if (coverage > 0.0) {
+        mean /= coverage;
+        normal = normalize(normal);
+        flags |= GEO_HAS_GEOMETRY;
+        // Coverage is a mean of 0s and 1s over 4^l pixels: exact in binary.
+        if (coverage == 4.0 && smooth_ranges(lo, hi)) flags |= GEO_SMOOTH;
+        bool split = (flags & GEO_SMOOTH) == 0u;
+        ivec2 below = imageSize(src_flags);
+        for (int dy = -1; dy <= 2 && !split; ++dy) {
+            for (int dx = -1; dx <= 2; ++dx) {
+                ivec2 q = 2 * p + ivec2(dx, dy);
+                if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, below))) continue;
+                if ((imageLoad(src_flags, q).r & GEO_SPLIT) != 0u) {
+                    split = true;
+                    break;
+                }
+            }
+        }
+        if (split) flags |= GEO_SPLIT;
+    }
+    imageStore(dst_mean, p, mean);
+    imageStore(dst_normal, p, vec4(normal, coverage * 0.25));
+    imageStore(dst_min, p, lo);
+    imageStore(dst_max, p, hi);
+    imageStore(dst_flags, p, uvec4(flags));
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(dst_flags)))) return;
+    if (level == 0) {
+        level_zero(p);
+    } else {
+        coarser_level(p);
+    }
+}

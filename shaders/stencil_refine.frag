@@ -1,0 +1,19 @@
+#version 460
+// Stenciled refinement (ALGORITHM.md section 3, step 4), one pass over every
+// layer: a fragment survives, and the stencil op writes 1, iff its texel is a
+// patch. Surviving fragments are also counted per level for --stats.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
+#include "multires.glsl"
+
+layout(constant_id = 0) const bool COUNT_PATCHES = true;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(set = 0, binding = 1) uniform usampler2D geo_flags;
+layout(set = 0, binding = 2, std430) buffer PatchCounts { uint patches_per_level[]; };
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    if (!is_patch(geo_flags, gl_Layer, u.hierarchy.x, p)) discard;
+    if (COUNT_PATCHES) atomicAdd(patches_per_level[gl_Layer], 1u);
+}

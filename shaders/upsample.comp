@@ -1,0 +1,106 @@
+#version 460
+// Upsampling of the multiresolution illumination buffer (ALGORITHM.md section
+// 3, step 7), one level per dispatch.
+//
+// Texel alpha: 1 = a patch the gather shaded; 0.5 = pulled (the mean of its
+// children, for texels split into finer patches); 0.75 = pushed (from the
+// coarser level); 0 = no value (yet).
+//
+// PULL (levels 1..L, finest first): texels without a value that have children
+// with values take their mean, so coarse neighbours of fine regions carry the
+// fine values. PUSH (levels L-1..0): texels without a value take their parent's
+// value (nearest) or bilinear weights over the four nearest coarser texels,
+// renormalised over those that hold a value and are on the same surface (no
+// depth or normal discontinuity). Level 0 is written to the indirect image.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(set = 0, binding = 1, rgba32f) uniform image2DArray illumination;
+layout(set = 0, binding = 2) uniform sampler2D geo_mean;    // w: mean view depth
+layout(set = 0, binding = 3) uniform sampler2D geo_normal;  // w: coverage
+layout(set = 0, binding = 4, rgba32f) writeonly uniform image2D indirect;
+
+layout(push_constant) uniform Push {
+    int level;
+    int pull_phase;  // 1: pull into `level` from level - 1; 0: push into `level` from level + 1
+};
+
+const float PULLED = 0.5;
+const float PUSHED = 0.75;
+
+ivec2 level_size(int l) { return ivec2(u.size.xy) >> l; }
+
+bool inside(ivec2 q, int l) { return all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, level_size(l))); }
+
+void pull_texel(ivec2 p) {
+    vec4 v = imageLoad(illumination, ivec3(p, level));
+    if (v.a > 0.0) return;
+    vec3 sum = vec3(0.0);
+    float n = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        vec4 c = imageLoad(illumination, ivec3(2 * p + ivec2(i & 1, i >> 1), level - 1));
+        if (c.a > 0.0) {
+            sum += c.rgb;
+            n += 1.0;
+        }
+    }
+    if (n > 0.0) imageStore(illumination, ivec3(p, level), vec4(sum / n, PULLED));
+}
+
+// Same surface: view depths within twice the refinement's relative depth
+// threshold and normals within twice its angle.
+bool same_surface(vec4 mean_a, vec3 n_a, vec4 mean_b, vec3 n_b) {
+    float depth_ok = abs(mean_a.w - mean_b.w) - 2.0 * u.refine.x * min(mean_a.w, mean_b.w);
+    float chord = length(n_a - n_b);
+    return depth_ok <= 0.0 && chord <= 2.0 * u.refine.y;
+}
+
+vec3 interpolate(ivec2 p, vec3 fallback) {
+    int up = level + 1;
+    vec4 mean = texelFetch(geo_mean, p, level);
+    vec3 n = texelFetch(geo_normal, p, level).xyz;
+    // Texel centre in the coarser level's texel coordinates.
+    vec2 c = (vec2(p) + 0.5) * 0.5 - 0.5;
+    ivec2 base = ivec2(floor(c));
+    vec2 f = c - vec2(base);
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        ivec2 o = ivec2(i & 1, i >> 1);
+        ivec2 q = base + o;
+        if (!inside(q, up)) continue;
+        vec4 v = imageLoad(illumination, ivec3(q, up));
+        if (v.a <= 0.0) continue;
+        vec4 qn = texelFetch(geo_normal, q, up);
+        if (qn.w <= 0.0 || !same_surface(mean, n, texelFetch(geo_mean, q, up), qn.xyz)) continue;
+        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+        sum += w * v.rgb;
+        weight += w;
+    }
+    return weight > 1e-6 ? sum / weight : fallback;
+}
+
+void push_texel(ivec2 p) {
+    vec4 v = imageLoad(illumination, ivec3(p, level));
+    bool geometry = texelFetch(geo_normal, p, level).w > 0.0;
+    if (v.a <= 0.0 && geometry) {
+        ivec2 parent = p >> 1;
+        vec3 nearest = inside(parent, level + 1) ? imageLoad(illumination, ivec3(parent, level + 1)).rgb : vec3(0.0);
+        bool interpolated = (u.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
+        v = vec4(interpolated ? interpolate(p, nearest) : nearest, PUSHED);
+        imageStore(illumination, ivec3(p, level), v);
+    }
+    if (level == 0) imageStore(indirect, p, vec4(geometry ? v.rgb : vec3(0.0), 1.0));
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (!inside(p, level)) return;
+    if (pull_phase != 0) {
+        pull_texel(p);
+    } else {
+        push_texel(p);
+    }
+}
