@@ -14,6 +14,7 @@
 layout(early_fragment_tests) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(location = 0) flat in int level;  // the layer (layered.vert)
 layout(set = 0, binding = 1) uniform sampler2D geo_mean;    // mip chain
 layout(set = 0, binding = 2) uniform sampler2D geo_normal;  // mip chain
 layout(set = 0, binding = 3) uniform usampler2D geo_flags;  // mip chain
@@ -25,7 +26,6 @@ layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2); a: 1 = this te
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    int level = gl_Layer;
     vec3 xi = texelFetch(geo_mean, p, level).xyz;
     vec3 ni = texelFetch(geo_normal, p, level).xyz;
     int k = u.hierarchy.y;

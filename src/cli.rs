@@ -1,7 +1,8 @@
 //! The `isr` command line: argument parsing and the `render`, `devices` and
 //! `export-builtin` commands. `main.rs` only calls [`run`].
 
-use crate::renderer::{Method, RenderSettings, Renderer};
+use crate::multires::{MultiresSettings, Upsample};
+use crate::renderer::{Method, RenderSettings, Renderer, VplSampling};
 use crate::vk::{Gpu, GpuOptions, Validation};
 use crate::{output, report, scene};
 use anyhow::{bail, Context as _, Result};
@@ -71,6 +72,49 @@ struct RenderArgs {
     /// Device index from `isr devices` (default: discrete > integrated > virtual > CPU).
     #[arg(long)]
     device: Option<usize>,
+    /// Regular VPLs (a power of 4): the sqrt(N) x sqrt(N) level of the RSM quadtree.
+    #[arg(long, default_value_t = 256)]
+    vpls: u32,
+    /// A VPL is its patch's mean, or the patch's centre texel with scaled flux.
+    #[arg(long, value_enum, default_value_t = VplSampling::Mean)]
+    vpl_sampling: VplSampling,
+    /// Coarsest level L of the multiresolution buffer (texels of 2^L x 2^L
+    /// pixels); default: about 1/16 of the shorter side (5 at 512).
+    #[arg(long)]
+    levels: Option<u32>,
+    /// Split a texel when its view-depth range relative to its nearest depth,
+    /// (max - min) / min, is not below this.
+    #[arg(long, default_value_t = 0.1)]
+    depth_threshold: f32,
+    /// Split a texel when its normals span this angle (degrees) or more.
+    #[arg(long, default_value_t = 20.0)]
+    normal_threshold: f32,
+    /// Upsampling of the multiresolution buffer to full resolution.
+    #[arg(long, value_enum, default_value_t = Upsample::Interpolated)]
+    upsample: Upsample,
+    /// Early stencil rejection in the gather; `off` shades every texel of every
+    /// level and masks afterwards (to measure what the stencil saves).
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    stencil: OnOff,
+    /// Print patch counts per level (also recorded in the timings JSON).
+    #[arg(long)]
+    stats: bool,
+    /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
+    /// patch, `indirect` shows the indirect light alone. Repeatable.
+    #[arg(long, value_enum)]
+    debug_view: Vec<DebugView>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum OnOff {
+    On,
+    Off,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum DebugView {
+    Levels,
+    Indirect,
 }
 
 /// Parses `std::env::args` and runs the command.
@@ -138,6 +182,15 @@ fn render(args: RenderArgs) -> Result<()> {
         rsm_resolution: args.rsm,
         method: args.method,
         exposure: args.exposure,
+        vpls: args.vpls,
+        vpl_sampling: args.vpl_sampling,
+        multires: MultiresSettings {
+            levels: args.levels,
+            depth_threshold: args.depth_threshold,
+            normal_threshold_deg: args.normal_threshold,
+            upsample: args.upsample,
+            stencil: args.stencil == OnOff::On,
+        },
         ..RenderSettings::default()
     };
     eprintln!(
@@ -161,6 +214,20 @@ fn render(args: RenderArgs) -> Result<()> {
         }
     })?;
     let result = renderer.readback()?;
+    let levels_view = if args.debug_view.contains(&DebugView::Levels) {
+        match renderer.readback_multires()? {
+            Some(m) => Some(crate::debug_view::levels_png(&m)),
+            None => bail!(
+                "--debug-view levels needs a multiresolution method (--method multires-gather)"
+            ),
+        }
+    } else {
+        None
+    };
+    let total_area = renderer
+        .multires_gather
+        .as_ref()
+        .map(|m| m.multires.buffer.total_area());
     drop(renderer);
 
     let r = report::build(
@@ -176,6 +243,15 @@ fn render(args: RenderArgs) -> Result<()> {
         &stats,
     );
     print!("{}", report::table(&r));
+    if args.stats {
+        match (&stats.patches_per_level, total_area) {
+            (Some(counts), Some(area)) => print!("{}", report::patch_table(counts, area)),
+            _ => println!(
+                "--stats: method {} has no multiresolution patches",
+                args.method.name()
+            ),
+        }
+    }
     if let Some(path) = &args.timings {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
@@ -188,6 +264,33 @@ fn render(args: RenderArgs) -> Result<()> {
     output::write_exr(&args.out, &result)?;
     output::write_png(&args.png, result.width, result.height, &result.display)?;
     println!("wrote {} and {}", args.out.display(), args.png.display());
+    let sibling = |suffix: &str| {
+        let stem = args
+            .png
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        args.png.with_file_name(format!("{stem}-{suffix}.png"))
+    };
+    if let Some(rgba) = levels_view {
+        let path = sibling("levels");
+        output::write_png(&path, result.width, result.height, &rgba)?;
+        println!(
+            "wrote {} (patch level per pixel: {})",
+            path.display(),
+            crate::debug_view::LEVEL_LEGEND
+        );
+    }
+    if args.debug_view.contains(&DebugView::Indirect) {
+        let path = sibling("indirect");
+        let rgba = crate::debug_view::indirect_png(&result, args.exposure);
+        output::write_png(&path, result.width, result.height, &rgba)?;
+        println!(
+            "wrote {} (indirect light alone: albedo/pi * E, exposure {})",
+            path.display(),
+            args.exposure
+        );
+    }
 
     let messages = gpu.take_validation_messages();
     if !messages.is_empty() {

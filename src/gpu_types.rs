@@ -23,7 +23,22 @@ pub struct FrameUniforms {
     pub exposure: [f32; 4],
     /// x, y: output size; z: RSM resolution.
     pub size: [u32; 4],
+    /// x: relative depth threshold; y: normal threshold as a chord length.
+    pub refine: [f32; 4],
+    /// x: coarsest level L; y: VPL level k of the RSM quadtree; z: VPLs per
+    /// side; w: `HIERARCHY_*` flags.
+    pub hierarchy: [i32; 4],
 }
+
+/// `hierarchy.w` bits, as in `shaders/shared.glsl`.
+pub const HIERARCHY_POINT_VPLS: i32 = 1;
+pub const HIERARCHY_INTERPOLATE: i32 = 2;
+pub const HIERARCHY_STENCIL_OFF: i32 = 4;
+
+/// Geometry-mip flag bits, as in `shaders/shared.glsl`.
+pub const GEO_HAS_GEOMETRY: u32 = 1;
+pub const GEO_SMOOTH: u32 = 2;
+pub const GEO_SPLIT: u32 = 4;
 
 /// `MaterialGpu` (std430).
 #[repr(C)]

@@ -6,7 +6,10 @@
 //! `vk` (device, resources, barriers, pipelines, timing), `scene`.
 
 pub mod cli;
+pub mod debug_view;
 pub mod gpu_types;
+pub mod methods;
+pub mod multires;
 pub mod output;
 pub mod passes;
 pub mod renderer;

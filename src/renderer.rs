@@ -1,7 +1,10 @@
 //! One frame of `isr`: scene upload, render targets, the passes in order, GPU
 //! timing of each, and readback of the results.
 
-use crate::gpu_types::{bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
+use crate::gpu_types::{self, bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
+use crate::methods::multires_gather::MultiresGather;
+use crate::multires::{MultiresSettings, Upsample};
+use crate::passes::rsm_tree::RsmTreePass;
 use crate::passes::{
     composite::CompositePass, direct_light::DirectLightPass, gbuffer::GBufferPass, rsm::RsmPass,
     tonemap::TonemapPass, FrameContext,
@@ -18,19 +21,31 @@ use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 use std::time::Instant;
 
-/// How indirect light is computed. Later issues add the image-space methods.
+/// How indirect light is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
     /// Direct light only: indirect irradiance is zero.
     None,
+    /// Stenciled gathering from N regular VPLs into the multiresolution buffer.
+    MultiresGather,
 }
 
 impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::None => "none",
+            Method::MultiresGather => "multires-gather",
         }
     }
+}
+
+/// How a regular VPL stands for its RSM patch (ALGORITHM.md section 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VplSampling {
+    /// The patch's mean position and normal, summed flux and area.
+    Mean,
+    /// The texel at the patch centre, flux and area scaled by the texel count.
+    Point,
 }
 
 #[derive(Clone, Debug)]
@@ -50,6 +65,10 @@ pub struct RenderSettings {
     pub pcf_radius: f32,
     /// Slope-scaled shadow bias, in RSM texels along the receiver's slope.
     pub shadow_slope_bias: f32,
+    /// Regular VPLs for the VPL methods: a power of 4, at most R^2.
+    pub vpls: u32,
+    pub vpl_sampling: VplSampling,
+    pub multires: MultiresSettings,
 }
 
 impl Default for RenderSettings {
@@ -64,6 +83,9 @@ impl Default for RenderSettings {
             shadow_depth_bias: 5e-4,
             pcf_radius: 1.0,
             shadow_slope_bias: 2.5,
+            vpls: 256,
+            vpl_sampling: VplSampling::Mean,
+            multires: MultiresSettings::default(),
         }
     }
 }
@@ -116,7 +138,9 @@ fn target_list() -> Vec<(&'static str, vk::Format, bool, vk::ImageUsageFlags)> {
             vk::Format::R32G32B32A32_SFLOAT,
             false,
             vk::ImageUsageFlags::from_raw(
-                COLOR_USAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_DST.as_raw(),
+                COLOR_USAGE.as_raw()
+                    | vk::ImageUsageFlags::TRANSFER_DST.as_raw()
+                    | vk::ImageUsageFlags::STORAGE.as_raw(),
             ),
         ),
         ("final", composite::FORMAT, false, COLOR_USAGE),
@@ -468,6 +492,8 @@ fn upload_texture(gpu: &Gpu, t: &crate::scene::Texture) -> Result<Image> {
 pub struct FrameStats {
     pub frames: Vec<Vec<PassSample>>,
     pub wall_ms: Vec<f64>,
+    /// Multiresolution patches per level of the last frame.
+    pub patches_per_level: Option<Vec<u32>>,
 }
 
 /// Image contents copied back to the host, rows top to bottom, RGBA f32.
@@ -509,6 +535,8 @@ pub struct Renderer<'g> {
     direct: DirectLightPass,
     composite: CompositePass,
     tonemap: TonemapPass,
+    rsm_tree: Option<RsmTreePass>,
+    pub multires_gather: Option<MultiresGather>,
     profiler: Profiler,
     frame_cmd: vk::CommandBuffer,
 }
@@ -577,7 +605,45 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     if !(s.exposure.is_finite() && s.exposure >= 0.0) {
         bail!("--exposure must be a finite non-negative number");
     }
+    if s.method != Method::None {
+        let side = (s.vpls as f64).sqrt() as u32;
+        if s.vpls == 0 || side * side != s.vpls || !side.is_power_of_two() {
+            bail!("--vpls {}: the number of regular VPLs must be a power of 4 (1, 4, 16, ..., 4096, ...)", s.vpls);
+        }
+        if side > r {
+            bail!(
+                "--vpls {} needs more RSM texels than --rsm {r} has ({} at most)",
+                s.vpls,
+                r as u64 * r as u64
+            );
+        }
+        let levels = levels_of(s);
+        if levels == 0
+            || s.width >> levels == 0
+            || s.height >> levels == 0
+            || levels >= crate::multires::MAX_LEVELS
+        {
+            bail!(
+                "--levels {levels}: the coarsest level must be at least 1 and its texels ({0}x{0} pixels) no larger than the image",
+                1u64 << levels.min(63)
+            );
+        }
+        let m = &s.multires;
+        if !(m.depth_threshold.is_finite() && m.depth_threshold >= 0.0)
+            || !(m.normal_threshold_deg.is_finite()
+                && (0.0..=180.0).contains(&m.normal_threshold_deg))
+        {
+            bail!("--depth-threshold must be >= 0 and --normal-threshold within 0..=180 degrees");
+        }
+    }
     Ok(())
+}
+
+/// The coarsest level L of the multiresolution buffer for these settings.
+pub fn levels_of(s: &RenderSettings) -> u32 {
+    s.multires
+        .levels
+        .unwrap_or_else(|| crate::multires::default_levels(s.width, s.height))
 }
 
 /// World -> clip for Vulkan: y flipped (framebuffer y points down), reversed-Z
@@ -607,6 +673,19 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
     let light_view_proj = projection(2.0 * half_fov, 1.0, light_near) * light_view;
     let (scale, offset) = l.cone_scale_offset();
     let r = s.rsm_resolution as f32;
+    let side = ((s.vpls as f64).sqrt() as u32).max(1);
+    let vpl_level = s.rsm_resolution.max(side).ilog2() - side.ilog2();
+    let mut flags = 0;
+    if s.vpl_sampling == VplSampling::Point {
+        flags |= gpu_types::HIERARCHY_POINT_VPLS;
+    }
+    if s.multires.upsample == Upsample::Interpolated {
+        flags |= gpu_types::HIERARCHY_INTERPOLATE;
+    }
+    if !s.multires.stencil {
+        flags |= gpu_types::HIERARCHY_STENCIL_OFF;
+    }
+    let chord = 2.0 * (0.5 * s.multires.normal_threshold_deg.to_radians()).sin();
     FrameUniforms {
         camera_view_proj: camera_view_proj.to_cols_array_2d(),
         light_view_proj: light_view_proj.to_cols_array_2d(),
@@ -624,6 +703,8 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
         ],
         exposure: [s.exposure, 0.0, 0.0, 0.0],
         size: [s.width, s.height, s.rsm_resolution, 0],
+        refine: [s.multires.depth_threshold, chord, 0.0, 0.0],
+        hierarchy: [levels_of(s) as i32, vpl_level as i32, side as i32, flags],
     }
 }
 
@@ -648,6 +729,21 @@ impl<'g> Renderer<'g> {
         let direct = DirectLightPass::new(gpu, &uniforms, &targets, &samplers)?;
         let composite = CompositePass::new(gpu, &uniforms, &targets, &samplers)?;
         let tonemap = TonemapPass::new(gpu, &uniforms, &targets, &samplers)?;
+        let rsm_tree = match settings.method {
+            Method::None => None,
+            _ => Some(RsmTreePass::new(gpu, &targets)?),
+        };
+        let multires_gather = match settings.method {
+            Method::MultiresGather => Some(MultiresGather::new(
+                gpu,
+                &uniforms,
+                &targets,
+                &samplers,
+                levels_of(settings),
+                settings.multires.stencil,
+            )?),
+            Method::None => None,
+        };
         let profiler = Profiler::new(gpu, MAX_PASSES)?;
         let frame_cmd = gpu.allocate_command_buffer()?;
         let mut r = Self {
@@ -663,10 +759,14 @@ impl<'g> Renderer<'g> {
             direct,
             composite,
             tonemap,
+            rsm_tree,
+            multires_gather,
             profiler,
             frame_cmd,
         };
-        r.clear_indirect()?;
+        if settings.method == Method::None {
+            r.clear_indirect()?;
+        }
         r.record_frame()?;
         Ok(r)
     }
@@ -717,8 +817,12 @@ impl<'g> Renderer<'g> {
         self.rsm.record(&ctx, p);
         self.gbuffer.record(&ctx, p);
         self.direct.record(&ctx, p);
-        match self.settings.method {
-            Method::None => {} // indirect stays zero (cleared once in `new`)
+        if let Some(t) = &self.rsm_tree {
+            t.record(&ctx, p);
+        }
+        // Method `none`: indirect stays zero (cleared once in `new`).
+        if let Some(m) = &self.multires_gather {
+            m.record(&ctx, p);
         }
         self.composite.record(&ctx, p);
         self.tonemap.record(&ctx, p);
@@ -735,6 +839,9 @@ impl<'g> Renderer<'g> {
             self.gpu.submit_and_wait(self.frame_cmd)?;
             stats.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
             stats.frames.push(self.profiler.read(self.gpu)?);
+            if let Some(m) = &self.multires_gather {
+                stats.patches_per_level = Some(m.multires.buffer.patch_counts());
+            }
             progress(i + 1);
         }
         Ok(stats)
@@ -755,7 +862,8 @@ impl<'g> Renderer<'g> {
             &t.rsm_normal,
             &t.rsm_flux,
         ];
-        let mut raw = read_images(self.gpu, &images)?.into_iter();
+        let regions: Vec<Region> = images.iter().map(|i| Region::color(i)).collect();
+        let mut raw = read_regions(self.gpu, &regions)?.into_iter();
         let mut next = || raw.next().unwrap();
         let final_radiance = to_rgba_f32(&next(), t.final_radiance.format);
         let direct = to_rgba_f32(&next(), t.direct.format);
@@ -785,45 +893,105 @@ impl<'g> Renderer<'g> {
     }
 }
 
-/// Copies single-layer color images (left in `READ_ONLY` by their passes) into
-/// host memory, in one submission.
-fn read_images(gpu: &Gpu, images: &[&Image]) -> Result<Vec<Vec<u8>>> {
+/// One mip level of one layer of an image, to copy to the host.
+#[derive(Clone, Copy)]
+pub struct Region<'a> {
+    pub image: &'a Image,
+    /// The image's resting state, restored after the copy.
+    pub from: Use,
+    pub mip: u32,
+    pub layer: u32,
+    /// COLOR, or STENCIL for the stencil of a depth/stencil image.
+    pub aspect: vk::ImageAspectFlags,
+}
+
+impl<'a> Region<'a> {
+    /// Mip 0 of a single-layer color image in the `READ_ONLY` convention state.
+    pub fn color(image: &'a Image) -> Self {
+        Self::mip(image, 0)
+    }
+
+    pub fn mip(image: &'a Image, mip: u32) -> Self {
+        Self {
+            image,
+            from: Use::READ_ONLY,
+            mip,
+            layer: 0,
+            aspect: vk::ImageAspectFlags::COLOR,
+        }
+    }
+
+    pub fn layer(image: &'a Image, layer: u32) -> Self {
+        Self {
+            layer,
+            ..Self::color(image)
+        }
+    }
+
+    fn bytes(&self) -> u64 {
+        let e = self.image.mip_extent(self.mip);
+        let texel = if self.aspect == vk::ImageAspectFlags::STENCIL {
+            1
+        } else {
+            texel_bytes(self.image.format)
+        };
+        e.width as u64 * e.height as u64 * texel
+    }
+}
+
+/// Copies `regions` into host memory in one submission; each image is back in
+/// its resting state afterwards.
+pub fn read_regions(gpu: &Gpu, regions: &[Region]) -> Result<Vec<Vec<u8>>> {
     let mut buffers = Vec::new();
-    for img in images {
-        let size = img.extent.width as u64 * img.extent.height as u64 * texel_bytes(img.format);
+    for r in regions {
         buffers.push(Buffer::new(
             gpu,
             "readback",
-            size,
+            r.bytes(),
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?);
     }
+    // One transition per image, however many of its regions are read.
+    let mut images: Vec<(&Image, Use)> = Vec::new();
+    for r in regions {
+        if !images.iter().any(|(i, _)| i.image == r.image.image) {
+            images.push((r.image, r.from));
+        }
+    }
     let result = gpu.run_once(|cmd| unsafe {
-        barrier::transition(gpu, cmd, images, Use::READ_ONLY, Use::TRANSFER_SRC);
-        for (img, buf) in images.iter().zip(&buffers) {
+        let to_src: Vec<_> = images
+            .iter()
+            .map(|(i, from)| barrier::image(i, *from, Use::TRANSFER_SRC))
+            .collect();
+        barrier::images(gpu, cmd, &to_src);
+        for (r, buf) in regions.iter().zip(&buffers) {
+            let e = r.image.mip_extent(r.mip);
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: img.aspect,
-                    mip_level: 0,
-                    base_array_layer: 0,
+                    aspect_mask: r.aspect,
+                    mip_level: r.mip,
+                    base_array_layer: r.layer,
                     layer_count: 1,
                 })
                 .image_extent(vk::Extent3D {
-                    width: img.extent.width,
-                    height: img.extent.height,
+                    width: e.width,
+                    height: e.height,
                     depth: 1,
                 });
             gpu.device.cmd_copy_image_to_buffer(
                 cmd,
-                img.image,
+                r.image.image,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 buf.buffer,
                 &[region],
             );
         }
-        // Back to the convention's resting state, and the copies visible to the host.
-        barrier::transition(gpu, cmd, images, Use::TRANSFER_SRC, Use::READ_ONLY);
+        let back: Vec<_> = images
+            .iter()
+            .map(|(i, from)| barrier::image(i, Use::TRANSFER_SRC, *from))
+            .collect();
+        barrier::images(gpu, cmd, &back);
         barrier::memory(
             gpu,
             cmd,
@@ -860,6 +1028,69 @@ fn to_rgba_f32(bytes: &[u8], format: vk::Format) -> Vec<[f32; 4]> {
     }
 }
 
+impl Renderer<'_> {
+    /// The multiresolution buffer of the last frame, if the method has one.
+    pub fn readback_multires(&self) -> Result<Option<MultiresReadback>> {
+        let Some(mg) = &self.multires_gather else {
+            return Ok(None);
+        };
+        let m = &mg.multires.buffer;
+        let t = &self.targets;
+        let n = m.levels + 1;
+        let mut regions = Vec::new();
+        regions.extend((0..n).map(|l| Region::layer(&m.illumination, l)));
+        regions.extend((0..n).map(|l| Region {
+            from: Use::STENCIL_READ_ONLY,
+            aspect: vk::ImageAspectFlags::STENCIL,
+            ..Region::layer(&m.stencil, l)
+        }));
+        for image in [&m.geo_mean, &m.geo_normal, &m.geo_flags] {
+            regions.extend((0..n).map(|l| Region::mip(image, l)));
+        }
+        let rsm_levels = t.rsm_position.mips;
+        for k in 0..rsm_levels {
+            for image in [&t.rsm_position, &t.rsm_normal, &t.rsm_flux] {
+                regions.push(Region::mip(image, k));
+            }
+        }
+        let mut raw = read_regions(self.gpu, &regions)?.into_iter();
+        let rgba = vk::Format::R32G32B32A32_SFLOAT;
+        let illumination: Vec<_> = (0..n)
+            .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
+            .collect();
+        let stencil: Vec<Vec<u8>> = (0..n).map(|_| raw.next().unwrap()).collect();
+        let geo_mean: Vec<_> = (0..n)
+            .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
+            .collect();
+        let geo_normal: Vec<_> = (0..n)
+            .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
+            .collect();
+        let geo_flags: Vec<Vec<u32>> = (0..n)
+            .map(|_| {
+                raw.next()
+                    .unwrap()
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+                    .collect()
+            })
+            .collect();
+        let rsm_tree = (0..rsm_levels)
+            .map(|_| std::array::from_fn(|_| to_rgba_f32(&raw.next().unwrap(), rgba)))
+            .collect();
+        Ok(Some(MultiresReadback {
+            width: self.settings.width,
+            height: self.settings.height,
+            levels: m.levels,
+            illumination,
+            stencil,
+            geo_mean,
+            geo_normal,
+            geo_flags,
+            rsm_tree,
+        }))
+    }
+}
+
 impl Drop for Renderer<'_> {
     fn drop(&mut self) {
         let gpu = self.gpu;
@@ -873,6 +1104,12 @@ impl Drop for Renderer<'_> {
         self.direct.destroy(gpu);
         self.composite.destroy(gpu);
         self.tonemap.destroy(gpu);
+        if let Some(t) = &mut self.rsm_tree {
+            t.destroy(gpu);
+        }
+        if let Some(m) = &mut self.multires_gather {
+            m.destroy(gpu);
+        }
         self.profiler.destroy(gpu);
         for i in self.targets.all_mut() {
             i.destroy(gpu);
@@ -881,4 +1118,21 @@ impl Drop for Renderer<'_> {
         self.uniforms.destroy(gpu);
         self.samplers.destroy(gpu);
     }
+}
+
+/// The multiresolution buffer copied back to the host (for tests and debug views).
+pub struct MultiresReadback {
+    pub width: u32,
+    pub height: u32,
+    pub levels: u32,
+    /// Per layer l, the whole W x H layer (the used corner is (W >> l) x (H >> l)).
+    pub illumination: Vec<Vec<[f32; 4]>>,
+    /// Per layer, stencil values, W x H.
+    pub stencil: Vec<Vec<u8>>,
+    /// Per mip level l, (W >> l) x (H >> l) texels.
+    pub geo_mean: Vec<Vec<[f32; 4]>>,
+    pub geo_normal: Vec<Vec<[f32; 4]>>,
+    pub geo_flags: Vec<Vec<u32>>,
+    /// RSM quadtree levels (level k is (R >> k)^2 texels): position, normal, flux.
+    pub rsm_tree: Vec<[Vec<[f32; 4]>; 3]>,
 }

@@ -34,6 +34,9 @@ pub struct TimingReport {
     pub indirect_gpu_ms_median: Option<f64>,
     /// Median CPU-measured time from submit to fence, for comparison.
     pub wall_ms_median: f64,
+    /// Multiresolution patches per level (level 0 first), last frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub patches_per_level: Option<Vec<u32>>,
 }
 
 pub fn median(values: &[f64]) -> Option<f64> {
@@ -108,7 +111,23 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         total_gpu_ms_median: median(&frame_sum(false)),
         indirect_gpu_ms_median: median(&frame_sum(true)),
         wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
+        patches_per_level: stats.patches_per_level.clone(),
     }
+}
+
+/// Patches per level against the area of all layers (what an unstenciled
+/// gather would shade).
+pub fn patch_table(counts: &[u32], total_area: u64) -> String {
+    let mut out = String::from("level  patches   pixels each\n");
+    for (l, c) in counts.iter().enumerate() {
+        out += &format!("{l:>5} {c:>9} {:>13}\n", 1u64 << (2 * l));
+    }
+    let total: u64 = counts.iter().map(|&c| c as u64).sum();
+    out += &format!(
+        "total {total:>9} patches = {:.2}% of the {total_area} texels in all layers\n",
+        100.0 * total as f64 / total_area as f64
+    );
+    out
 }
 
 fn ms(v: Option<f64>) -> String {

@@ -91,7 +91,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", size: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", hierarchy: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -103,6 +103,8 @@ fn frame_uniforms_match_shared_glsl() {
             shadow => "shadow",
             exposure => "exposure",
             size => "size",
+            refine => "refine",
+            hierarchy => "hierarchy",
         ]);
     }
 }
@@ -123,6 +125,36 @@ fn draw_push_matches_shared_glsl() {
         material => "material",
         pad => "pad0",
     ]);
+}
+
+/// The flag constants are written twice (GLSL and Rust); read GLSL's.
+#[test]
+fn flag_constants_match_shared_glsl() {
+    let glsl = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/shared.glsl"))
+        .unwrap();
+    let value = |name: &str| -> u32 {
+        let line = glsl
+            .lines()
+            .find(|l| l.contains(&format!(" {name} = ")))
+            .unwrap_or_else(|| panic!("{name} not in shared.glsl"));
+        let v = line
+            .split('=')
+            .nth(1)
+            .unwrap()
+            .split(';')
+            .next()
+            .unwrap()
+            .trim()
+            .trim_end_matches('u');
+        v.parse().unwrap()
+    };
+    use isr::gpu_types::*;
+    assert_eq!(value("HIERARCHY_POINT_VPLS"), HIERARCHY_POINT_VPLS as u32);
+    assert_eq!(value("HIERARCHY_INTERPOLATE"), HIERARCHY_INTERPOLATE as u32);
+    assert_eq!(value("HIERARCHY_STENCIL_OFF"), HIERARCHY_STENCIL_OFF as u32);
+    assert_eq!(value("GEO_HAS_GEOMETRY"), GEO_HAS_GEOMETRY);
+    assert_eq!(value("GEO_SMOOTH"), GEO_SMOOTH);
+    assert_eq!(value("GEO_SPLIT"), GEO_SPLIT);
 }
 
 #[test]

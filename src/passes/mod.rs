@@ -16,6 +16,7 @@ pub mod composite;
 pub mod direct_light;
 pub mod gbuffer;
 pub mod rsm;
+pub mod rsm_tree;
 pub mod tonemap;
 
 use crate::gpu_types::{bytes_of, DrawPush};
@@ -333,3 +334,86 @@ pub struct FrameContext<'a> {
     pub scene: &'a SceneGpu,
     pub targets: &'a crate::renderer::Targets,
 }
+
+/// A compute shader with one descriptor set per dispatch variant (for example
+/// one per mip level: storage views of different levels need different sets).
+pub struct ComputePass {
+    pipeline: Pipeline,
+    sets: Vec<DescriptorSet>,
+}
+
+impl ComputePass {
+    /// `variants[i]` are the bindings of set `i`; all variants share one layout.
+    pub fn new(
+        gpu: &Gpu,
+        name: &str,
+        shader: &str,
+        variants: &[Vec<Binding>],
+        push_constant_bytes: u32,
+        specialization: &[(u32, i32)],
+    ) -> Result<Self> {
+        let mut sets = Vec::new();
+        for bindings in variants {
+            sets.push(DescriptorSet::new(gpu, name, bindings)?);
+        }
+        let pipeline = Pipeline::compute(
+            gpu,
+            name,
+            shader,
+            &[sets[0].layout],
+            push_constant_bytes,
+            specialization,
+        )?;
+        Ok(Self { pipeline, sets })
+    }
+
+    /// Dispatches 8x8 workgroups covering `extent` with set `variant`.
+    pub fn dispatch(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        variant: usize,
+        push: &[u8],
+        extent: vk::Extent2D,
+    ) {
+        let d = &gpu.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.pipeline.layout,
+                0,
+                &[self.sets[variant].set],
+                &[],
+            );
+            if !push.is_empty() {
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline.layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    push,
+                );
+            }
+            d.cmd_dispatch(cmd, extent.width.div_ceil(8), extent.height.div_ceil(8), 1);
+        }
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        for s in &mut self.sets {
+            s.destroy(gpu);
+        }
+    }
+}
+
+/// Timing kind of passes that exist only for indirect light.
+pub const INDIRECT_GRAPHICS: PassKind = PassKind {
+    graphics: true,
+    indirect: true,
+};
+pub const INDIRECT_COMPUTE: PassKind = PassKind {
+    graphics: false,
+    indirect: true,
+};

@@ -76,6 +76,28 @@ impl Use {
         ),
         layout: vk::ImageLayout::GENERAL,
     };
+    /// A stencil buffer written by stencil operations.
+    pub const STENCIL_ATTACHMENT: Use = Use::DEPTH_ATTACHMENT;
+    /// The stencil's resting state after it is written: read-only by stencil
+    /// tests and copies. (Not `SHADER_READ_ONLY_OPTIMAL`: S8 need not be sampleable.)
+    pub const STENCIL_READ_ONLY: Use = Use {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::COPY.as_raw(),
+        ),
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw()
+                | vk::AccessFlags2::TRANSFER_READ.as_raw(),
+        ),
+        layout: vk::ImageLayout::READ_ONLY_OPTIMAL,
+    };
+    /// Contents discarded after the stencil's readers are done.
+    pub const DISCARD_AFTER_STENCIL_READERS: Use = Use {
+        stage: Use::STENCIL_READ_ONLY.stage,
+        access: vk::AccessFlags2::NONE,
+        layout: vk::ImageLayout::UNDEFINED,
+    };
     pub const TRANSFER_DST: Use = Use {
         stage: vk::PipelineStageFlags2::from_raw(
             vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::CLEAR.as_raw(),
@@ -134,6 +156,22 @@ pub fn images(gpu: &Gpu, cmd: vk::CommandBuffer, barriers: &[vk::ImageMemoryBarr
 pub fn transition(gpu: &Gpu, cmd: vk::CommandBuffer, targets: &[&Image], from: Use, to: Use) {
     let barriers: Vec<_> = targets.iter().map(|i| image(i, from, to)).collect();
     images(gpu, cmd, &barriers);
+}
+
+/// Makes one compute dispatch's storage writes visible to the next dispatch.
+pub fn compute_to_compute(gpu: &Gpu, cmd: vk::CommandBuffer) {
+    let rw = vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+    );
+    memory(
+        gpu,
+        cmd,
+        vk::PipelineStageFlags2::COMPUTE_SHADER,
+        vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        vk::PipelineStageFlags2::COMPUTE_SHADER,
+        rw,
+    );
 }
 
 /// A global memory barrier (buffers, host visibility).

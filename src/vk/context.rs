@@ -395,9 +395,11 @@ impl Gpu {
             .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
             .shader_output_layer(features.shader_output_layer);
+        // Demote is required by Vulkan 1.3; glslang compiles `discard` to it for SPIR-V 1.6.
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
-            .synchronization2(true);
+            .synchronization2(true)
+            .shader_demote_to_helper_invocation(true);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)

@@ -1,0 +1,259 @@
+//! The eye-space hierarchy of ALGORITHM.md section 3: geometry mipmaps, the
+//! layered multiresolution illumination buffer with its layered stencil, the
+//! one-pass stenciled refinement and the upsampling. The methods that gather or
+//! splat into the buffer live in `methods/`.
+
+pub mod geometry_mips;
+pub mod stencil_refine;
+pub mod upsample;
+
+use crate::vk::{Buffer, Gpu, Image, ImageDesc};
+use anyhow::{anyhow, bail, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Upsample {
+    /// Bilinear between neighbouring patches, renormalised, never across a discontinuity.
+    Interpolated,
+    /// Each pixel takes the value of the patch that covers it.
+    Nearest,
+}
+
+#[derive(Clone, Debug)]
+pub struct MultiresSettings {
+    /// Coarsest level L (level l texels cover 2^l x 2^l pixels); `None` picks
+    /// one from the resolution (`default_levels`).
+    pub levels: Option<u32>,
+    /// A texel is smooth when its view-depth range, relative to its nearest
+    /// depth, is below this: `(max - min) / min < t`.
+    pub depth_threshold: f32,
+    /// ... and when the normals in it span less than this angle (degrees),
+    /// measured as the diagonal of their component-wise bounding box.
+    pub normal_threshold_deg: f32,
+    pub upsample: Upsample,
+    /// Early stencil rejection in the gather (`false`: shade every texel of
+    /// every layer and mask afterwards, for measuring what the stencil saves).
+    pub stencil: bool,
+}
+
+impl Default for MultiresSettings {
+    fn default() -> Self {
+        Self {
+            levels: None,
+            depth_threshold: 0.1,
+            normal_threshold_deg: 20.0,
+            upsample: Upsample::Interpolated,
+            stencil: true,
+        }
+    }
+}
+
+/// Coarsest level for a resolution: texels of level L are about 1/16 of the
+/// shorter side (L = 5 at 512, 6 at 1024), at most 8.
+pub fn default_levels(width: u32, height: u32) -> u32 {
+    (width.min(height).max(2).ilog2().saturating_sub(4)).clamp(1, 8)
+}
+
+/// The largest number of levels the patch-count buffer holds.
+pub const MAX_LEVELS: u32 = 16;
+
+/// The images of the hierarchy. Geometry mips are mip chains of W x H images
+/// (mip l is (W >> l) x (H >> l)); the illumination buffer and its stencil are
+/// 2D arrays with one W x H layer per level, layer l using its corner.
+pub struct MultiresBuffer {
+    /// Coarsest level L; levels are 0..=L.
+    pub levels: u32,
+    pub geo_mean: Image,
+    pub geo_normal: Image,
+    pub geo_min: Image,
+    pub geo_max: Image,
+    pub geo_flags: Image,
+    /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.comp`).
+    pub illumination: Image,
+    pub stencil: Image,
+    /// Patches per level, counted by the refinement (host-visible).
+    pub patch_counts: Buffer,
+}
+
+impl MultiresBuffer {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, levels: u32) -> Result<Self> {
+        let stencil_format = gpu
+            .pick_format(
+                &[
+                    vk::Format::S8_UINT,
+                    vk::Format::D24_UNORM_S8_UINT,
+                    vk::Format::D32_SFLOAT_S8_UINT,
+                ],
+                vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::FormatFeatureFlags::TRANSFER_SRC,
+            )
+            .ok_or_else(|| anyhow!("the device has no stencil format usable as an attachment"))?;
+        if !gpu.features.shader_output_layer {
+            bail!(
+                "{} cannot choose the layer in a vertex shader (Vulkan 1.2 shaderOutputLayer), \
+                 which the multiresolution buffer needs; choose another --device or --method",
+                gpu.info.name
+            );
+        }
+        let extent = vk::Extent2D { width, height };
+        let storage = vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let mip_chain = |name, format| {
+            Image::new(
+                gpu,
+                &ImageDesc {
+                    name,
+                    format,
+                    extent,
+                    layers: 1,
+                    mips: levels + 1,
+                    usage: storage,
+                },
+            )
+        };
+        let layered = |name, format, usage| {
+            Image::new(
+                gpu,
+                &ImageDesc {
+                    name,
+                    format,
+                    extent,
+                    layers: levels + 1,
+                    mips: 1,
+                    usage,
+                },
+            )
+        };
+        let rgba = vk::Format::R32G32B32A32_SFLOAT;
+        Ok(Self {
+            levels,
+            geo_mean: mip_chain("geo_mean", rgba)?,
+            geo_normal: mip_chain("geo_normal", rgba)?,
+            geo_min: mip_chain("geo_min", rgba)?,
+            geo_max: mip_chain("geo_max", rgba)?,
+            geo_flags: mip_chain("geo_flags", vk::Format::R32_UINT)?,
+            illumination: layered(
+                "illumination",
+                rgba,
+                storage | vk::ImageUsageFlags::COLOR_ATTACHMENT,
+            )?,
+            stencil: layered(
+                "stencil",
+                stencil_format,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            )?,
+            patch_counts: Buffer::new(
+                gpu,
+                "patch counts",
+                4 * MAX_LEVELS as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?,
+        })
+    }
+
+    /// Patches per level of the last frame (read after its fence).
+    pub fn patch_counts(&self) -> Vec<u32> {
+        self.patch_counts.mapped()[..4 * (self.levels as usize + 1)]
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    }
+
+    /// Texels in the used corners of all layers: what a gather without the
+    /// stencil shades.
+    pub fn total_area(&self) -> u64 {
+        let e = self.illumination.extent;
+        (0..=self.levels)
+            .map(|l| (e.width >> l) as u64 * (e.height >> l) as u64)
+            .sum()
+    }
+
+    pub fn geometry_images(&self) -> [&Image; 5] {
+        [
+            &self.geo_mean,
+            &self.geo_normal,
+            &self.geo_min,
+            &self.geo_max,
+            &self.geo_flags,
+        ]
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        for i in [
+            &mut self.geo_mean,
+            &mut self.geo_normal,
+            &mut self.geo_min,
+            &mut self.geo_max,
+            &mut self.geo_flags,
+            &mut self.illumination,
+            &mut self.stencil,
+        ] {
+            i.destroy(gpu);
+        }
+        self.patch_counts.destroy(gpu);
+    }
+}
+
+/// The hierarchy's passes around a method's gather or splat: geometry mips and
+/// stenciled refinement before it, upsampling after it.
+pub struct Multires {
+    pub buffer: MultiresBuffer,
+    geometry_mips: geometry_mips::GeometryMipsPass,
+    stencil_refine: stencil_refine::StencilRefinePass,
+    upsample: upsample::UpsamplePass,
+}
+
+impl Multires {
+    pub fn new(
+        gpu: &Gpu,
+        uniforms: &Buffer,
+        targets: &crate::renderer::Targets,
+        samplers: &crate::renderer::Samplers,
+        levels: u32,
+    ) -> Result<Self> {
+        let e = targets.gbuffer_position.extent;
+        let buffer = MultiresBuffer::new(gpu, e.width, e.height, levels)?;
+        Ok(Self {
+            geometry_mips: geometry_mips::GeometryMipsPass::new(
+                gpu, uniforms, targets, samplers, &buffer,
+            )?,
+            stencil_refine: stencil_refine::StencilRefinePass::new(
+                gpu,
+                uniforms,
+                samplers.nearest,
+                &buffer,
+            )?,
+            upsample: upsample::UpsamplePass::new(gpu, uniforms, targets, samplers, &buffer)?,
+            buffer,
+        })
+    }
+
+    /// Geometry mips, then the stencil of patches.
+    pub fn record_refinement(
+        &self,
+        ctx: &crate::passes::FrameContext,
+        p: &mut crate::vk::profiler::Profiler,
+    ) {
+        self.geometry_mips.record(ctx, p, &self.buffer);
+        self.stencil_refine.record(ctx, p, &self.buffer);
+    }
+
+    /// The illumination buffer to the full-resolution `indirect` image.
+    pub fn record_upsample(
+        &self,
+        ctx: &crate::passes::FrameContext,
+        p: &mut crate::vk::profiler::Profiler,
+    ) {
+        self.upsample.record(ctx, p, &self.buffer);
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.geometry_mips.destroy(gpu);
+        self.stencil_refine.destroy(gpu);
+        self.upsample.destroy(gpu);
+        self.buffer.destroy(gpu);
+    }
+}

@@ -1,0 +1,70 @@
+//! Pass `rsm-tree`: the RSM quadtree (ALGORITHM.md section 2, patches) in the
+//! mip chains of the RSM images, `shaders/rsm_tree.comp`, one dispatch per
+//! level, level k merging 2x2 texels of level k - 1.
+//! Reads RSM mip 0; writes RSM mips 1.. (barriers below).
+
+use super::{ComputePass, FrameContext, INDIRECT_COMPUTE};
+use crate::renderer::Targets;
+use crate::vk::barrier::{self, Use};
+use crate::vk::pipeline::Binding;
+use crate::vk::profiler::Profiler;
+use crate::vk::Gpu;
+use anyhow::Result;
+
+pub struct RsmTreePass(ComputePass);
+
+impl RsmTreePass {
+    pub fn new(gpu: &Gpu, t: &Targets) -> Result<Self> {
+        let images = [&t.rsm_position, &t.rsm_normal, &t.rsm_flux];
+        let variants: Vec<Vec<Binding>> = (1..t.rsm_position.mips as usize)
+            .map(|k| {
+                let src = images
+                    .iter()
+                    .map(|i| Binding::StorageImage(i.mip_views[k - 1]));
+                let dst = images.iter().map(|i| Binding::StorageImage(i.mip_views[k]));
+                src.chain(dst).collect()
+            })
+            .collect();
+        Ok(Self(ComputePass::new(
+            gpu,
+            "rsm-tree",
+            "rsm_tree.comp",
+            &variants,
+            0,
+            &[],
+        )?))
+    }
+
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd, t) = (ctx.gpu, ctx.cmd, ctx.targets);
+        let images = [&t.rsm_position, &t.rsm_normal, &t.rsm_flux];
+        let mips = t.rsm_position.mips;
+        profiler.pass(gpu, cmd, "rsm-tree", INDIRECT_COMPUTE, || {
+            // Level 0 (the RSM) is kept; the coarser levels are rewritten.
+            let mut before = Vec::new();
+            for i in images {
+                before.push(barrier::mips(i, 0, 1, Use::READ_ONLY, Use::COMPUTE_STORAGE));
+                before.push(barrier::mips(
+                    i,
+                    1,
+                    mips - 1,
+                    Use::DISCARD_AFTER_READERS,
+                    Use::COMPUTE_STORAGE,
+                ));
+            }
+            barrier::images(gpu, cmd, &before);
+            for k in 1..mips {
+                if k > 1 {
+                    barrier::compute_to_compute(gpu, cmd);
+                }
+                self.0
+                    .dispatch(gpu, cmd, k as usize - 1, &[], t.rsm_position.mip_extent(k));
+            }
+            barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
+        });
+    }
+
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.0.destroy(gpu);
+    }
+}
