@@ -52,7 +52,8 @@ void level_zero(ivec2 p) {
         imageStore(dst_flags, p, uvec4(0u));
         return;
     }
-    vec3 n = texelFetch(gbuffer_normal, p, 0).xyz;
+    // Renormalised: the G-buffer stores normals as 16-bit floats.
+    vec3 n = normalize(texelFetch(gbuffer_normal, p, 0).xyz);
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
     ivec2 size = ivec2(u.size.xy);
     for (int dy = -1; dy <= 1; ++dy) {

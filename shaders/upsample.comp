@@ -59,26 +59,43 @@ bool same_surface(vec4 mean_a, vec3 n_a, vec4 mean_b, vec3 n_b) {
 
 vec3 interpolate(ivec2 p, vec3 fallback) {
     int up = level + 1;
+    ivec2 size = level_size(up);
     vec4 mean = texelFetch(geo_mean, p, level);
     vec3 n = texelFetch(geo_normal, p, level).xyz;
     // Texel centre in the coarser level's texel coordinates.
     vec2 c = (vec2(p) + 0.5) * 0.5 - 0.5;
     ivec2 base = ivec2(floor(c));
-    vec2 f = c - vec2(base);
+    // At the image border the 2x2 footprint would leave the level: keep it
+    // inside, which turns the weights into a linear extrapolation (fractions
+    // outside 0..1). Without this, border pixels would repeat the value of a
+    // texel centre up to 3.5 pixels inside (ALGORITHM.md section 3, step 7).
+    ivec2 clamped = clamp(base, ivec2(0), max(size - 2, ivec2(0)));
+    vec2 f = c - vec2(clamped);
     vec3 sum = vec3(0.0);
     float weight = 0.0;
+    bool all_valid = true;
     for (int i = 0; i < 4; ++i) {
         ivec2 o = ivec2(i & 1, i >> 1);
-        ivec2 q = base + o;
-        if (!inside(q, up)) continue;
-        vec4 v = imageLoad(illumination, ivec3(q, up));
-        if (v.a <= 0.0) continue;
-        vec4 qn = texelFetch(geo_normal, q, up);
-        if (qn.w <= 0.0 || !same_surface(mean, n, texelFetch(geo_mean, q, up), qn.xyz)) continue;
+        ivec2 q = clamped + o;
+        bool valid = inside(q, up);
+        vec4 v = vec4(0.0);
+        if (valid) {
+            v = imageLoad(illumination, ivec3(q, up));
+            vec4 qn = texelFetch(geo_normal, q, up);
+            valid = v.a > 0.0 && qn.w > 0.0 && same_surface(mean, n, texelFetch(geo_mean, q, up), qn.xyz);
+        }
+        if (!valid) {
+            all_valid = false;
+            continue;
+        }
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
         sum += w * v.rgb;
         weight += w;
     }
+    if (all_valid) return sum;  // the weights sum to 1, extrapolating or not
+    if (clamped != base) return fallback;  // no extrapolation from a partial footprint
+    // Renormalise over the texels that hold a value on the same surface; the
+    // fractions are within 0..1 here, so the weights are non-negative.
     return weight > 1e-6 ? sum / weight : fallback;
 }
 

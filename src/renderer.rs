@@ -629,10 +629,10 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
             );
         }
         let m = &s.multires;
-        if !(m.depth_threshold.is_finite() && m.depth_threshold >= 0.0)
-            || !(m.normal_threshold_deg.is_finite()
-                && (0.0..=180.0).contains(&m.normal_threshold_deg))
-        {
+        let depth_ok = m.depth_threshold.is_finite() && m.depth_threshold >= 0.0;
+        let normal_ok =
+            m.normal_threshold_deg.is_finite() && (0.0..=180.0).contains(&m.normal_threshold_deg);
+        if !(depth_ok && normal_ok) {
             bail!("--depth-threshold must be >= 0 and --normal-threshold within 0..=180 degrees");
         }
     }

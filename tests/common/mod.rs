@@ -122,3 +122,72 @@ pub fn expected_direct(light: &SpotLight, albedo: Vec4, p: DVec3, n: DVec3) -> D
 pub fn bin() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_isr"))
 }
+
+pub struct RenderedMultires {
+    pub readback: Readback,
+    pub multires: isr::renderer::MultiresReadback,
+    pub stats: FrameStats,
+    pub uniforms: isr::gpu_types::FrameUniforms,
+    pub total_area: u64,
+}
+
+/// Renders with a multiresolution method and reads back its buffer too.
+pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> RenderedMultires {
+    let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
+    let stats = r.render_frames(1, |_| {}).expect("rendering");
+    let readback = r.readback().expect("readback");
+    let multires = r
+        .readback_multires()
+        .expect("readback")
+        .expect("a multiresolution method");
+    let uniforms = *r.uniforms();
+    let total_area = r
+        .multires_gather
+        .as_ref()
+        .unwrap()
+        .multires
+        .buffer
+        .total_area();
+    drop(r);
+    assert_validation_clean(gpu);
+    RenderedMultires {
+        readback,
+        multires,
+        stats,
+        uniforms,
+        total_area,
+    }
+}
+
+/// The regular VPLs of RSM quadtree level `k` as (position, normal, flux, area).
+pub fn vpls_at(m: &isr::renderer::MultiresReadback, k: usize) -> Vec<(DVec3, DVec3, DVec3, f64)> {
+    let [pos, nrm, flux] = &m.rsm_tree[k];
+    pos.iter()
+        .zip(nrm)
+        .zip(flux)
+        .filter(|((p, _), _)| p[3] > 0.0)
+        .map(|((p, n), f)| {
+            let v = |a: &[f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+            (v(p), v(n), v(f), p[3] as f64)
+        })
+        .collect()
+}
+
+/// ALGORITHM.md section 2 in f64: sum over patches of
+/// Phi_j cos_i cos_j / (pi d^2 + A_j), the irradiance at (x, n).
+pub fn cpu_gather(vpls: &[(DVec3, DVec3, DVec3, f64)], x: DVec3, n: DVec3) -> DVec3 {
+    let mut e = DVec3::ZERO;
+    for &(xj, nj, phi, a) in vpls {
+        let v = xj - x;
+        let d2 = v.length_squared();
+        let dir = v / d2.sqrt().max(1e-15);
+        let cos_i = n.dot(dir).max(0.0);
+        let cos_j = (-nj.dot(dir)).max(0.0);
+        e += phi * (cos_i * cos_j / (std::f64::consts::PI * d2 + a));
+    }
+    e
+}
+
+pub fn dvec(a: &[f32; 4]) -> DVec3 {
+    DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
+}
