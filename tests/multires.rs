@@ -266,7 +266,7 @@ fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
     let vpls = vpls_at(m, out.uniforms.hierarchy[1] as usize);
     let w = m.width;
     let mut checked = vec![0; m.levels as usize + 1];
-    for l in 0..=m.levels as usize {
+    for (l, count) in checked.iter_mut().enumerate() {
         let lw = w >> l;
         for y in 0..m.height >> l {
             for x in 0..lw {
@@ -282,7 +282,7 @@ fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
                     err <= 1e-4 * expected.max_element() + 1e-7,
                     "level {l} patch ({x}, {y}): GPU {got:?} vs CPU {expected:?}"
                 );
-                checked[l] += 1;
+                *count += 1;
             }
         }
     }
