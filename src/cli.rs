@@ -39,7 +39,7 @@ struct RenderArgs {
     #[arg(long)]
     scene: Option<PathBuf>,
     /// How indirect light is computed.
-    #[arg(long, value_enum, default_value_t = Method::None)]
+    #[arg(long, value_enum, default_value_t = Method::MultiresGather)]
     method: Method,
     /// Output width in pixels.
     #[arg(long, default_value_t = 512)]
