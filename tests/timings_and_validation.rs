@@ -2,7 +2,7 @@
 mod common;
 
 use common::*;
-use isr::renderer::RenderSettings;
+use isr::renderer::{Method, RenderSettings};
 use isr::scene::cornell::cornell_box;
 
 const PASSES: [&str; 5] = ["rsm", "gbuffer", "direct", "composite", "tonemap"];
@@ -91,7 +91,41 @@ fn timings_json_from_the_cli_lists_every_pass() {
     assert_eq!(v["frames"], 3);
     let passes = v["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    assert_eq!(names, PASSES);
+    // The default method, multires-gather, adds its indirect passes between
+    // direct light and the composite.
+    let indirect = [
+        "rsm-tree",
+        "geometry-mips",
+        "stencil-refine",
+        "gather",
+        "upsample",
+    ];
+    let expected: Vec<&str> = PASSES[..3]
+        .iter()
+        .chain(&indirect)
+        .chain(&PASSES[3..])
+        .copied()
+        .collect();
+    assert_eq!(names, expected);
+    let mut indirect_sum = 0.0;
+    for p in passes {
+        let is_indirect = indirect.contains(&p["name"].as_str().unwrap());
+        assert_eq!(p["indirect"].as_bool(), Some(is_indirect), "{p}");
+        if is_indirect {
+            indirect_sum += p["gpu_ms_median"].as_f64().unwrap();
+        }
+    }
+    let indirect_median = v["indirect_gpu_ms_median"].as_f64().unwrap();
+    assert!(indirect_median > 0.0 && indirect_median <= v["total_gpu_ms_median"].as_f64().unwrap());
+    // A median of sums is not a sum of medians, but over 3 similar frames they are close.
+    assert!(
+        (indirect_median - indirect_sum).abs() <= 0.5 * indirect_sum,
+        "{indirect_median} vs {indirect_sum}"
+    );
+    let patches = v["patches_per_level"]
+        .as_array()
+        .expect("patch counts in the JSON");
+    assert!(patches.iter().map(|c| c.as_u64().unwrap()).sum::<u64>() > 0);
     let mut sum = 0.0;
     for p in passes {
         let med = p["gpu_ms_median"].as_f64().unwrap();
@@ -101,13 +135,9 @@ fn timings_json_from_the_cli_lists_every_pass() {
         sum += med;
     }
     assert!(sum > 0.0);
-    assert_eq!(
-        v["indirect_gpu_ms_median"].as_f64(),
-        Some(0.0),
-        "method none has no indirect passes"
-    );
+
     let table = String::from_utf8_lossy(&out.stdout);
-    for name in PASSES {
+    for name in expected {
         assert!(
             table.contains(name),
             "the printed table lacks {name}:\n{table}"
@@ -133,15 +163,25 @@ fn validating_gpu() -> isr::vk::Gpu {
 fn validation_with_synchronization_checks_is_silent_over_several_frames() {
     let gpu = validating_gpu();
     assert!(gpu.validating());
-    let settings = RenderSettings {
-        width: 160,
-        height: 120,
-        rsm_resolution: 128,
-        ..Default::default()
-    };
-    // `render` asserts that no message was reported (frames replay one command
-    // buffer, so frame 2 onwards checks the hazards between frames too).
-    render(&gpu, &cornell_box(), &settings, 3);
+    for (method, stencil) in [
+        (Method::None, true),
+        (Method::MultiresGather, true),
+        (Method::MultiresGather, false),
+    ] {
+        let mut settings = RenderSettings {
+            width: 160,
+            height: 120,
+            rsm_resolution: 128,
+            method,
+            ..Default::default()
+        };
+        settings.multires.stencil = stencil;
+        // `render` asserts that no message was reported (frames replay one
+        // command buffer, so frame 2 onwards checks the hazards between frames
+        // too), and reads every output back.
+        let out = render(&gpu, &cornell_box(), &settings, 3);
+        assert_eq!(out.stats.frames.len(), 3);
+    }
 }
 
 /// Silence is only evidence if the layer would speak: two unsynchronized
