@@ -87,15 +87,8 @@ impl StencilRefinePass {
                     }),
                 },
             );
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline.layout,
-                0,
-                &[self.set.set],
-                &[],
-            );
+            self.pipeline
+                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
             d.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
             d.cmd_end_rendering(cmd);
             barrier::transition(

@@ -208,15 +208,8 @@ impl ScenePass {
         );
         let d = &gpu.device;
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline.layout,
-                0,
-                &[scene.set.set],
-                &[],
-            );
+            self.pipeline
+                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, scene.set.set);
             d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
             d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
             for draw in &scene.draws {
@@ -306,15 +299,8 @@ impl FullscreenPass {
         );
         let d = &gpu.device;
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline.layout,
-                0,
-                &[self.set.set],
-                &[],
-            );
+            self.pipeline
+                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
             d.cmd_draw(cmd, 3, 1, 0, 0);
             d.cmd_end_rendering(cmd);
         }
@@ -378,14 +364,11 @@ impl ComputePass {
     ) {
         let d = &gpu.device;
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
+            self.pipeline.bind(
+                gpu,
                 cmd,
                 vk::PipelineBindPoint::COMPUTE,
-                self.pipeline.layout,
-                0,
-                &[self.sets[variant].set],
-                &[],
+                self.sets[variant].set,
             );
             if !push.is_empty() {
                 d.cmd_push_constants(

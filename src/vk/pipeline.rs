@@ -438,6 +438,21 @@ impl Pipeline {
         Ok(Self { pipeline, layout })
     }
 
+    /// Binds the pipeline and `set` (as set 0) for graphics or compute.
+    pub fn bind(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        point: vk::PipelineBindPoint,
+        set: vk::DescriptorSet,
+    ) {
+        unsafe {
+            gpu.device.cmd_bind_pipeline(cmd, point, self.pipeline);
+            gpu.device
+                .cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[set], &[]);
+        }
+    }
+
     pub fn destroy(&mut self, gpu: &Gpu) {
         unsafe {
             gpu.device.destroy_pipeline(self.pipeline, None);
