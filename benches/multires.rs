@@ -45,7 +45,7 @@ fn main() -> anyhow::Result<()> {
         let gather = last.iter().find(|p| p.name == "gather").unwrap();
         let m = r.readback_multires()?.unwrap();
         let area = r
-            .multires_gather
+            .gather_method
             .as_ref()
             .unwrap()
             .multires

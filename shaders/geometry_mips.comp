@@ -91,7 +91,8 @@ void coarser_level(ivec2 p) {
     uint flags = 0u;
     if (coverage > 0.0) {
         mean /= coverage;
-        normal = normalize(normal);
+        // Opposite normals (two sides of a thin sheet) can cancel: no direction then.
+        normal = dot(normal, normal) > 1e-12 ? normalize(normal) : vec3(0.0);
         flags |= GEO_HAS_GEOMETRY;
         // Coverage is a mean of 0s and 1s over 4^l pixels: exact in binary.
         if (coverage == 4.0 && smooth_ranges(lo, hi)) flags |= GEO_SMOOTH;

@@ -16,7 +16,7 @@ layout(location = 2) in vec2 in_uv;
 
 // The layout every level of the RSM quadtree shares (see rsm_tree.comp).
 layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: A_j (m^2), 0 where nothing was seen
-layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: 1 where geometry was seen
+layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: PATCH_VALID (1) where geometry was seen
 layout(location = 2) out vec4 out_flux;      // rgb: Phi_j (W); a: dw_j (sr)
 
 // Smallest cosine used for A_j: a surface seen edge-on by the light would get an

@@ -3,14 +3,26 @@
 // texel of level k merges its four children of level k-1. Flux and solid angle
 // add up, area adds up, position is the area-weighted mean and the normal the
 // normalised area-weighted mean.
+//
+// Validity (normal.w, see PATCH_*): a patch is valid when all its non-empty
+// children are valid and lie on one surface: each child's mean within the
+// depth threshold (relative to its distance to the light) of the patch's
+// plane, and its normal within the angle threshold of the patch's normal.
+// Children's means are compared rather than full ranges, so a patch keeps only
+// a flag; since validity needs valid children, a discontinuity anywhere below
+// invalidates every ancestor.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0, rgba32f) readonly uniform image2D src_position;  // xyz: position; w: area A
-layout(set = 0, binding = 1, rgba32f) readonly uniform image2D src_normal;    // xyz: normal; w: 1 if seen
-layout(set = 0, binding = 2, rgba32f) readonly uniform image2D src_flux;      // rgb: flux; a: solid angle
-layout(set = 0, binding = 3, rgba32f) writeonly uniform image2D dst_position;
-layout(set = 0, binding = 4, rgba32f) writeonly uniform image2D dst_normal;
-layout(set = 0, binding = 5, rgba32f) writeonly uniform image2D dst_flux;
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+
+layout(set = 0, binding = 1, rgba32f) readonly uniform image2D src_position;  // xyz: position; w: area A
+layout(set = 0, binding = 2, rgba32f) readonly uniform image2D src_normal;    // xyz: normal; w: PATCH_*
+layout(set = 0, binding = 3, rgba32f) readonly uniform image2D src_flux;      // rgb: flux; a: solid angle
+layout(set = 0, binding = 4, rgba32f) writeonly uniform image2D dst_position;
+layout(set = 0, binding = 5, rgba32f) writeonly uniform image2D dst_normal;
+layout(set = 0, binding = 6, rgba32f) writeonly uniform image2D dst_flux;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -19,20 +31,37 @@ void main() {
     vec3 weighted_position = vec3(0.0);
     vec3 weighted_normal = vec3(0.0);
     float area = 0.0;
-    float seen = 0.0;
+    bool children_valid = true;
+    vec4 child_position[4];
+    vec4 child_normal[4];
     for (int i = 0; i < 4; ++i) {
         ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
-        vec4 pos = imageLoad(src_position, c);
-        vec4 nrm = imageLoad(src_normal, c);
+        child_position[i] = imageLoad(src_position, c);
+        child_normal[i] = imageLoad(src_normal, c);
         flux += imageLoad(src_flux, c);
-        weighted_position += pos.w * pos.xyz;
-        weighted_normal += pos.w * nrm.xyz;
-        area += pos.w;
-        seen = max(seen, nrm.w);
+        weighted_position += child_position[i].w * child_position[i].xyz;
+        weighted_normal += child_position[i].w * child_normal[i].xyz;
+        area += child_position[i].w;
+        children_valid = children_valid && child_normal[i].w != PATCH_INVALID;
     }
     vec3 position = area > 0.0 ? weighted_position / area : vec3(0.0);
     vec3 normal = dot(weighted_normal, weighted_normal) > 0.0 ? normalize(weighted_normal) : vec3(0.0);
+    float state = PATCH_EMPTY;
+    if (area > 0.0) {
+        // One surface: every non-empty child's mean lies near the patch's plane
+        // (offset along the mean normal under the depth threshold times its
+        // distance to the light) and its normal within the angle of the mean.
+        // A slanted plane passes however much its distance to the light varies.
+        bool one_surface = children_valid;
+        for (int i = 0; i < 4; ++i) {
+            if (child_normal[i].w == PATCH_EMPTY) continue;
+            float offset = abs(dot(child_position[i].xyz - position, normal));
+            float reach = u.light_tree.y * distance(child_position[i].xyz, u.light_position.xyz);
+            one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > u.light_tree.z;
+        }
+        state = one_surface ? PATCH_VALID : PATCH_INVALID;
+    }
     imageStore(dst_position, p, vec4(position, area));
-    imageStore(dst_normal, p, vec4(normal, seen));
+    imageStore(dst_normal, p, vec4(normal, state));
     imageStore(dst_flux, p, flux);
 }

@@ -24,7 +24,25 @@ struct FrameUniforms {
                             // length |n_max - n_min| of the component box, 2 sin(angle / 2))
     ivec4 hierarchy;        // x: coarsest level L; y: RSM quadtree level k of the VPLs;
                             // z: VPLs per side sqrt(N); w: flags, see HIERARCHY_*
+    vec4 light_tree;        // light-space hierarchy (ALGORITHM.md sections 2 and 4): x: HISR's T at
+                            // the finest level, 2 (I - tau) / (3 tau R^2); y: patch validity depth
+                            // threshold (relative distance to the light); z: validity normal
+                            // threshold (cosine); w: I, the light's peak intensity (W/sr)
+    ivec4 light_levels;     // x: HISR start depth (2^x x 2^x patches); y: HISR max depth;
+                            // z: ISR base level (RSM mip); w: log2 R, the top mip (one patch)
 };
+
+// One light patch chosen by Basic ISR (a node of the RSM quadtree).
+struct LightPatch {
+    vec4 position_area;  // xyz: area-weighted mean position (m); w: area A (m^2)
+    vec4 normal;         // xyz: unit mean normal; w: RSM quadtree level
+    vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr)
+};
+
+// RSM quadtree normal.w: what a patch is.
+const float PATCH_EMPTY = 0.0;    // saw no geometry
+const float PATCH_VALID = 1.0;    // one surface: may stand for all its texels
+const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity: must be subdivided
 
 // hierarchy.w bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up

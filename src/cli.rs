@@ -2,7 +2,7 @@
 //! `export-builtin` commands. `main.rs` only calls [`run`].
 
 use crate::multires::{MultiresSettings, Upsample};
-use crate::renderer::{Method, RenderSettings, Renderer, VplSampling};
+use crate::renderer::{LightTreeSettings, Method, RenderSettings, Renderer, VplSampling};
 use crate::vk::{Gpu, GpuOptions, Validation};
 use crate::{output, report, scene};
 use anyhow::{bail, Context as _, Result};
@@ -99,8 +99,31 @@ struct RenderArgs {
     /// Print patch counts per level (also recorded in the timings JSON).
     #[arg(long)]
     stats: bool,
+    /// Basic ISR's dense starting level, in patches per side (a power of 2).
+    #[arg(long, default_value_t = 64)]
+    isr_base: u32,
+    /// HISR starts its traversal from 2^s x 2^s light patches.
+    #[arg(long, default_value_t = 2)]
+    start_level: u32,
+    /// HISR subdivides at most down to 2^d x 2^d patches (at most log2 of
+    /// --rsm; default 6, or log2 of --rsm if smaller); patches spanning a
+    /// discontinuity are always split down to it.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// HISR's error threshold, as a fraction of the light's peak intensity: a
+    /// light patch is subdivided while its contribution could exceed tau * I.
+    #[arg(long, default_value_t = 0.05)]
+    tau: f32,
+    /// Light patches merge only when their distances to the light differ by
+    /// less than this fraction of the nearest.
+    #[arg(long, default_value_t = 0.1)]
+    light_depth_threshold: f32,
+    /// ... and their normals by less than this angle (degrees).
+    #[arg(long, default_value_t = 30.0)]
+    light_normal_threshold: f32,
     /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
-    /// patch, `indirect` shows the indirect light alone. Repeatable.
+    /// patch, `indirect` shows the indirect light alone, `vpl-count` is a heat
+    /// map of the light patches evaluated per pixel. Repeatable.
     #[arg(long, value_enum)]
     debug_view: Vec<DebugView>,
 }
@@ -115,6 +138,7 @@ enum OnOff {
 enum DebugView {
     Levels,
     Indirect,
+    VplCount,
 }
 
 /// Parses `std::env::args` and runs the command.
@@ -191,6 +215,14 @@ fn render(args: RenderArgs) -> Result<()> {
             upsample: args.upsample,
             stencil: args.stencil == OnOff::On,
         },
+        light_tree: LightTreeSettings {
+            depth_threshold: args.light_depth_threshold,
+            normal_threshold_deg: args.light_normal_threshold,
+            isr_base: args.isr_base,
+            start_level: args.start_level,
+            max_depth: Some(args.max_depth.unwrap_or(6.min(args.rsm.max(1).ilog2()))),
+            tau: args.tau,
+        },
         ..RenderSettings::default()
     };
     eprintln!(
@@ -214,18 +246,40 @@ fn render(args: RenderArgs) -> Result<()> {
         }
     })?;
     let result = renderer.readback()?;
-    let levels_view = if args.debug_view.contains(&DebugView::Levels) {
-        match renderer.readback_multires()? {
-            Some(m) => Some(crate::debug_view::levels_png(&m)),
-            None => bail!(
-                "--debug-view levels needs a multiresolution method (--method multires-gather)"
-            ),
-        }
-    } else {
-        None
+    // For --stats, the debug views and the timings JSON's light-patch numbers.
+    let multires = renderer.readback_multires()?;
+    let light_stats = match &multires {
+        Some(m) => Some(crate::debug_view::light_patch_stats(
+            m,
+            renderer.isr_chosen_count()?,
+        )),
+        None => None,
     };
+    let mut extra_views = Vec::new();
+    for view in &args.debug_view {
+        let (suffix, what, rgba) = match (view, &multires) {
+            (DebugView::Indirect, _) => continue,
+            (_, None) => bail!(
+                "--debug-view levels and vpl-count need a method with the multiresolution buffer"
+            ),
+            (DebugView::Levels, Some(m)) => (
+                "levels",
+                format!("patch level per pixel: {}", crate::debug_view::LEVEL_LEGEND),
+                crate::debug_view::levels_png(m),
+            ),
+            (DebugView::VplCount, Some(m)) => {
+                let (rgba, max) = crate::debug_view::vpl_count_png(m);
+                (
+                    "vpl-count",
+                    format!("light patches evaluated per pixel, black 0 to white {max}"),
+                    rgba,
+                )
+            }
+        };
+        extra_views.push((suffix, what, rgba));
+    }
     let total_area = renderer
-        .multires_gather
+        .gather_method
         .as_ref()
         .map(|m| m.multires.buffer.total_area());
     drop(renderer);
@@ -242,10 +296,15 @@ fn render(args: RenderArgs) -> Result<()> {
         },
         &stats,
     );
+    let mut r = r;
+    r.light_patches = light_stats.clone();
     print!("{}", report::table(&r));
     if args.stats {
-        match (&stats.patches_per_level, total_area) {
-            (Some(counts), Some(area)) => print!("{}", report::patch_table(counts, area)),
+        match (&stats.patches_per_level, total_area, &light_stats) {
+            (Some(counts), Some(area), Some(light)) => {
+                print!("{}", report::patch_table(counts, area));
+                println!("{light}");
+            }
             _ => println!(
                 "--stats: method {} has no multiresolution patches",
                 args.method.name()
@@ -272,14 +331,10 @@ fn render(args: RenderArgs) -> Result<()> {
             .unwrap_or_default();
         args.png.with_file_name(format!("{stem}-{suffix}.png"))
     };
-    if let Some(rgba) = levels_view {
-        let path = sibling("levels");
+    for (suffix, what, rgba) in extra_views {
+        let path = sibling(suffix);
         output::write_png(&path, result.width, result.height, &rgba)?;
-        println!(
-            "wrote {} (patch level per pixel: {})",
-            path.display(),
-            crate::debug_view::LEVEL_LEGEND
-        );
+        println!("wrote {} ({what})", path.display());
     }
     if args.debug_view.contains(&DebugView::Indirect) {
         let path = sibling("indirect");

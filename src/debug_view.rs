@@ -65,3 +65,78 @@ pub fn indirect_png(r: &Readback, exposure: f32) -> Vec<u8> {
         })
         .collect()
 }
+
+/// Light patches evaluated per eye-space patch: how many, over all patches.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LightPatchStats {
+    /// Patches Basic ISR chose this frame (method `isr`).
+    pub chosen: Option<u32>,
+    pub per_patch_min: u32,
+    pub per_patch_mean: f64,
+    pub per_patch_max: u32,
+    /// Light-patch evaluations in the whole gather.
+    pub total_evaluations: u64,
+}
+
+impl std::fmt::Display for LightPatchStats {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(c) = self.chosen {
+            write!(f, "light patches chosen by ISR: {c}; ")?;
+        }
+        write!(
+            f,
+            "light patches per eye-space patch: min {}, mean {:.1}, max {} ({} evaluations in all)",
+            self.per_patch_min, self.per_patch_mean, self.per_patch_max, self.total_evaluations
+        )
+    }
+}
+
+/// Statistics of the evaluation counts over every patch of the buffer.
+pub fn light_patch_stats(m: &MultiresReadback, chosen: Option<u32>) -> LightPatchStats {
+    let mut counts = Vec::new();
+    for l in 0..=m.levels as usize {
+        for y in 0..m.height >> l {
+            for x in 0..m.width >> l {
+                let i = (y * m.width + x) as usize;
+                if m.illumination[l][i][3] == 1.0 {
+                    counts.push(m.evaluations[l][i]);
+                }
+            }
+        }
+    }
+    let total: u64 = counts.iter().map(|&c| c as u64).sum();
+    LightPatchStats {
+        chosen,
+        per_patch_min: counts.iter().copied().min().unwrap_or(0),
+        per_patch_mean: total as f64 / counts.len().max(1) as f64,
+        per_patch_max: counts.iter().copied().max().unwrap_or(0),
+        total_evaluations: total,
+    }
+}
+
+/// Heat map of the light patches evaluated for each pixel's patch (black, red,
+/// yellow, white as the count rises to the maximum), and that maximum.
+pub fn vpl_count_png(m: &MultiresReadback) -> (Vec<u8>, u32) {
+    let w = m.width;
+    let counts: Vec<Option<u32>> = patch_levels(m)
+        .into_iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            l.map(|l| m.evaluations[l as usize][((y >> l) * w + (x >> l)) as usize])
+        })
+        .collect();
+    let max = counts.iter().flatten().copied().max().unwrap_or(0).max(1);
+    let rgba = counts
+        .iter()
+        .flat_map(|c| match c {
+            None => [0, 0, 64, 255],
+            Some(c) => {
+                let t = *c as f32 / max as f32;
+                let ramp = |a: f32| ((t * 3.0 - a).clamp(0.0, 1.0) * 255.0) as u8;
+                [ramp(0.0), ramp(1.0), ramp(2.0), 255]
+            }
+        })
+        .collect();
+    (rgba, max)
+}

@@ -28,7 +28,33 @@ pub struct FrameUniforms {
     /// x: coarsest level L; y: VPL level k of the RSM quadtree; z: VPLs per
     /// side; w: `HIERARCHY_*` flags.
     pub hierarchy: [i32; 4],
+    /// x: HISR's T at the finest level; y: patch validity depth threshold
+    /// (relative distance to the light); z: validity normal threshold (cosine);
+    /// w: the light's peak intensity I (W/sr).
+    pub light_tree: [f32; 4],
+    /// x: HISR start depth; y: HISR max depth; z: ISR base mip; w: log2 R.
+    pub light_levels: [i32; 4],
 }
+
+/// `LightPatch` (std430): one patch chosen by Basic ISR.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightPatch {
+    /// xyz: mean position; w: area.
+    pub position_area: [f32; 4],
+    /// xyz: mean normal; w: quadtree level (RSM mip).
+    pub normal: [f32; 4],
+    /// rgb: flux; a: solid angle.
+    pub flux: [f32; 4],
+}
+
+/// Header of the chosen-patch buffer before the `LightPatch` array.
+pub const CHOSEN_PATCHES_HEADER: usize = 16;
+
+/// RSM quadtree `normal.w` values, as in `shaders/shared.glsl`.
+pub const PATCH_EMPTY: f32 = 0.0;
+pub const PATCH_VALID: f32 = 1.0;
+pub const PATCH_INVALID: f32 = -1.0;
 
 /// `hierarchy.w` bits, as in `shaders/shared.glsl`.
 pub const HIERARCHY_POINT_VPLS: i32 = 1;

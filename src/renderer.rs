@@ -2,7 +2,7 @@
 //! timing of each, and readback of the results.
 
 use crate::gpu_types::{self, bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
-use crate::methods::multires_gather::MultiresGather;
+use crate::methods::gather::GatherMethod;
 use crate::multires::{MultiresSettings, Upsample};
 use crate::passes::rsm_tree::RsmTreePass;
 use crate::passes::{
@@ -28,6 +28,10 @@ pub enum Method {
     None,
     /// Stenciled gathering from N regular VPLs into the multiresolution buffer.
     MultiresGather,
+    /// Basic ISR: per-frame clustered light patches, gathered by every eye patch.
+    Isr,
+    /// Hierarchical ISR: a per-fragment traversal of the RSM quadtree.
+    Hisr,
 }
 
 impl Method {
@@ -35,6 +39,41 @@ impl Method {
         match self {
             Method::None => "none",
             Method::MultiresGather => "multires-gather",
+            Method::Isr => "isr",
+            Method::Hisr => "hisr",
+        }
+    }
+}
+
+/// The light-space hierarchy (ALGORITHM.md section 4).
+#[derive(Clone, Debug)]
+pub struct LightTreeSettings {
+    /// A patch is valid (one surface) when its children's distances to the
+    /// light differ by less than this fraction of the nearest.
+    pub depth_threshold: f32,
+    /// ... and their normals by less than this angle (degrees).
+    pub normal_threshold_deg: f32,
+    /// Basic ISR's dense starting level: patches per side (a power of 2, at most R).
+    pub isr_base: u32,
+    /// HISR starts from 2^s x 2^s patches.
+    pub start_level: u32,
+    /// HISR subdivides down to 2^d x 2^d patches (`None`: the RSM itself,
+    /// log2 R). Invalid patches are always subdivided down to this depth, so
+    /// it bounds the cost of discontinuities in light space.
+    pub max_depth: Option<u32>,
+    /// HISR's error threshold tau, as a fraction of the light's peak intensity.
+    pub tau: f32,
+}
+
+impl Default for LightTreeSettings {
+    fn default() -> Self {
+        Self {
+            depth_threshold: 0.1,
+            normal_threshold_deg: 30.0,
+            isr_base: 64,
+            start_level: 2,
+            max_depth: Some(6),
+            tau: 0.05,
         }
     }
 }
@@ -69,6 +108,7 @@ pub struct RenderSettings {
     pub vpls: u32,
     pub vpl_sampling: VplSampling,
     pub multires: MultiresSettings,
+    pub light_tree: LightTreeSettings,
 }
 
 impl Default for RenderSettings {
@@ -86,6 +126,7 @@ impl Default for RenderSettings {
             vpls: 256,
             vpl_sampling: VplSampling::Mean,
             multires: MultiresSettings::default(),
+            light_tree: LightTreeSettings::default(),
         }
     }
 }
@@ -271,6 +312,13 @@ impl Samplers {
             gpu.device.destroy_sampler(self.texture, None);
         }
     }
+}
+
+/// What passes read that the renderer owns: frame uniforms, targets, samplers.
+pub struct FrameInputs<'a> {
+    pub uniforms: &'a Buffer,
+    pub targets: &'a Targets,
+    pub samplers: &'a Samplers,
 }
 
 /// One indexed draw of a mesh instance.
@@ -536,7 +584,8 @@ pub struct Renderer<'g> {
     composite: CompositePass,
     tonemap: TonemapPass,
     rsm_tree: Option<RsmTreePass>,
-    pub multires_gather: Option<MultiresGather>,
+    /// The method's passes (`None` for method `none`).
+    pub gather_method: Option<GatherMethod>,
     profiler: Profiler,
     frame_cmd: vk::CommandBuffer,
 }
@@ -629,6 +678,33 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
             );
         }
         let m = &s.multires;
+        let lt = &s.light_tree;
+        if !lt.isr_base.is_power_of_two() || lt.isr_base > r {
+            bail!(
+                "--isr-base {}: the base must be a power of 2 no larger than --rsm {r}",
+                lt.isr_base
+            );
+        }
+        let top = r.ilog2();
+        let max_depth = lt.max_depth.unwrap_or(top);
+        if max_depth > top || lt.start_level > max_depth {
+            bail!(
+                "--start-level {} and --max-depth {max_depth} must satisfy start <= max <= log2(--rsm) = {top}",
+                lt.start_level
+            );
+        }
+        if !(lt.tau > 0.0 && lt.tau < 1.0) {
+            bail!(
+                "--tau {}: tau is a fraction of the light's intensity, strictly between 0 and 1",
+                lt.tau
+            );
+        }
+        if !(lt.depth_threshold.is_finite()
+            && lt.depth_threshold >= 0.0
+            && (0.0..=180.0).contains(&lt.normal_threshold_deg))
+        {
+            bail!("--light-depth-threshold must be >= 0 and --light-normal-threshold within 0..=180 degrees");
+        }
         let depth_ok = m.depth_threshold.is_finite() && m.depth_threshold >= 0.0;
         let normal_ok =
             m.normal_threshold_deg.is_finite() && (0.0..=180.0).contains(&m.normal_threshold_deg);
@@ -637,6 +713,11 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The RSM quadtree level (mip) Basic ISR starts from.
+pub fn isr_base_mip(s: &RenderSettings) -> u32 {
+    s.rsm_resolution.ilog2() - s.light_tree.isr_base.clamp(1, s.rsm_resolution).ilog2()
 }
 
 /// The coarsest level L of the multiresolution buffer for these settings.
@@ -686,6 +767,8 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
         flags |= gpu_types::HIERARCHY_STENCIL_OFF;
     }
     let chord = 2.0 * (0.5 * s.multires.normal_threshold_deg.to_radians()).sin();
+    let lt = &s.light_tree;
+    let top = s.rsm_resolution.ilog2();
     FrameUniforms {
         camera_view_proj: camera_view_proj.to_cols_array_2d(),
         light_view_proj: light_view_proj.to_cols_array_2d(),
@@ -705,6 +788,18 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
         size: [s.width, s.height, s.rsm_resolution, 0],
         refine: [s.multires.depth_threshold, chord, 0.0, 0.0],
         hierarchy: [levels_of(s) as i32, vpl_level as i32, side as i32, flags],
+        light_tree: [
+            crate::methods::hisr::subdivision_threshold(lt.tau, s.rsm_resolution),
+            lt.depth_threshold,
+            lt.normal_threshold_deg.to_radians().cos(),
+            (l.color * l.intensity).max_element(),
+        ],
+        light_levels: [
+            lt.start_level as i32,
+            lt.max_depth.unwrap_or(top) as i32,
+            isr_base_mip(s) as i32,
+            top as i32,
+        ],
     }
 }
 
@@ -731,18 +826,19 @@ impl<'g> Renderer<'g> {
         let tonemap = TonemapPass::new(gpu, &uniforms, &targets, &samplers)?;
         let rsm_tree = match settings.method {
             Method::None => None,
-            _ => Some(RsmTreePass::new(gpu, &targets)?),
+            _ => Some(RsmTreePass::new(gpu, &uniforms, &targets)?),
         };
-        let multires_gather = match settings.method {
-            Method::MultiresGather => Some(MultiresGather::new(
-                gpu,
-                &uniforms,
-                &targets,
-                &samplers,
-                levels_of(settings),
-                settings.multires.stencil,
-            )?),
+        let gather_method = match settings.method {
             Method::None => None,
+            _ => Some(GatherMethod::new(
+                gpu,
+                &FrameInputs {
+                    uniforms: &uniforms,
+                    targets: &targets,
+                    samplers: &samplers,
+                },
+                settings,
+            )?),
         };
         let profiler = Profiler::new(gpu, MAX_PASSES)?;
         let frame_cmd = gpu.allocate_command_buffer()?;
@@ -760,7 +856,7 @@ impl<'g> Renderer<'g> {
             composite,
             tonemap,
             rsm_tree,
-            multires_gather,
+            gather_method,
             profiler,
             frame_cmd,
         };
@@ -821,7 +917,7 @@ impl<'g> Renderer<'g> {
             t.record(&ctx, p);
         }
         // Method `none`: indirect stays zero (cleared once in `new`).
-        if let Some(m) = &self.multires_gather {
+        if let Some(m) = &self.gather_method {
             m.record(&ctx, p);
         }
         self.composite.record(&ctx, p);
@@ -839,7 +935,7 @@ impl<'g> Renderer<'g> {
             self.gpu.submit_and_wait(self.frame_cmd)?;
             stats.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
             stats.frames.push(self.profiler.read(self.gpu)?);
-            if let Some(m) = &self.multires_gather {
+            if let Some(m) = &self.gather_method {
                 stats.patches_per_level = Some(m.multires.buffer.patch_counts());
             }
             progress(i + 1);
@@ -1008,6 +1104,43 @@ pub fn read_regions(gpu: &Gpu, regions: &[Region]) -> Result<Vec<Vec<u8>>> {
     result.map(|_| out)
 }
 
+/// Copies a device-local buffer to the host (after the frames that wrote it).
+pub fn read_buffer(gpu: &Gpu, buffer: &Buffer) -> Result<Vec<u8>> {
+    let mut staging = Buffer::new(
+        gpu,
+        "readback",
+        buffer.size,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+    )?;
+    let result = gpu.run_once(|cmd| unsafe {
+        gpu.device.cmd_copy_buffer(
+            cmd,
+            buffer.buffer,
+            staging.buffer,
+            &[vk::BufferCopy::default().size(buffer.size)],
+        );
+        barrier::memory(
+            gpu,
+            cmd,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+    });
+    let bytes = staging.mapped().to_vec();
+    staging.destroy(gpu);
+    result.map(|_| bytes)
+}
+
+fn to_u32(bytes: &[u8]) -> Vec<u32> {
+    bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
 fn to_rgba_f32(bytes: &[u8], format: vk::Format) -> Vec<[f32; 4]> {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => bytes
@@ -1029,9 +1162,41 @@ fn to_rgba_f32(bytes: &[u8], format: vk::Format) -> Vec<[f32; 4]> {
 }
 
 impl Renderer<'_> {
+    /// The light patches Basic ISR chose in the last frame (`None` for other methods).
+    pub fn isr_chosen(&self) -> Result<Option<Vec<gpu_types::LightPatch>>> {
+        let Some(isr) = self.gather_method.as_ref().and_then(|m| m.isr.as_ref()) else {
+            return Ok(None);
+        };
+        let bytes = read_buffer(self.gpu, &isr.chosen)?;
+        let count = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
+        let size = std::mem::size_of::<gpu_types::LightPatch>();
+        let start = gpu_types::CHOSEN_PATCHES_HEADER;
+        Ok(Some(
+            bytes[start..start + count * size]
+                .chunks_exact(size)
+                .map(|c| {
+                    let f: Vec<f32> = c
+                        .chunks_exact(4)
+                        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+                        .collect();
+                    gpu_types::LightPatch {
+                        position_area: f[0..4].try_into().unwrap(),
+                        normal: f[4..8].try_into().unwrap(),
+                        flux: f[8..12].try_into().unwrap(),
+                    }
+                })
+                .collect(),
+        ))
+    }
+
+    /// How many light patches Basic ISR chose in the last frame.
+    pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
+        Ok(self.isr_chosen()?.map(|c| c.len() as u32))
+    }
+
     /// The multiresolution buffer of the last frame, if the method has one.
     pub fn readback_multires(&self) -> Result<Option<MultiresReadback>> {
-        let Some(mg) = &self.multires_gather else {
+        let Some(mg) = &self.gather_method else {
             return Ok(None);
         };
         let m = &mg.multires.buffer;
@@ -1039,6 +1204,7 @@ impl Renderer<'_> {
         let n = m.levels + 1;
         let mut regions = Vec::new();
         regions.extend((0..n).map(|l| Region::layer(&m.illumination, l)));
+        regions.extend((0..n).map(|l| Region::layer(&m.evaluations, l)));
         regions.extend((0..n).map(|l| Region {
             from: Use::STENCIL_READ_ONLY,
             aspect: vk::ImageAspectFlags::STENCIL,
@@ -1058,6 +1224,7 @@ impl Renderer<'_> {
         let illumination: Vec<_> = (0..n)
             .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
             .collect();
+        let evaluations: Vec<Vec<u32>> = (0..n).map(|_| to_u32(&raw.next().unwrap())).collect();
         let stencil: Vec<Vec<u8>> = (0..n).map(|_| raw.next().unwrap()).collect();
         let geo_mean: Vec<_> = (0..n)
             .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
@@ -1065,15 +1232,7 @@ impl Renderer<'_> {
         let geo_normal: Vec<_> = (0..n)
             .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
             .collect();
-        let geo_flags: Vec<Vec<u32>> = (0..n)
-            .map(|_| {
-                raw.next()
-                    .unwrap()
-                    .chunks_exact(4)
-                    .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
-                    .collect()
-            })
-            .collect();
+        let geo_flags: Vec<Vec<u32>> = (0..n).map(|_| to_u32(&raw.next().unwrap())).collect();
         let rsm_tree = (0..rsm_levels)
             .map(|_| std::array::from_fn(|_| to_rgba_f32(&raw.next().unwrap(), rgba)))
             .collect();
@@ -1082,6 +1241,7 @@ impl Renderer<'_> {
             height: self.settings.height,
             levels: m.levels,
             illumination,
+            evaluations,
             stencil,
             geo_mean,
             geo_normal,
@@ -1107,7 +1267,7 @@ impl Drop for Renderer<'_> {
         if let Some(t) = &mut self.rsm_tree {
             t.destroy(gpu);
         }
-        if let Some(m) = &mut self.multires_gather {
+        if let Some(m) = &mut self.gather_method {
             m.destroy(gpu);
         }
         self.profiler.destroy(gpu);
@@ -1127,6 +1287,8 @@ pub struct MultiresReadback {
     pub levels: u32,
     /// Per layer l, the whole W x H layer (the used corner is (W >> l) x (H >> l)).
     pub illumination: Vec<Vec<[f32; 4]>>,
+    /// Per layer l, light patches each texel evaluated (W x H).
+    pub evaluations: Vec<Vec<u32>>,
     /// Per layer, stencil values, W x H.
     pub stencil: Vec<Vec<u8>>,
     /// Per mip level l, (W >> l) x (H >> l) texels.

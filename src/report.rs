@@ -37,6 +37,9 @@ pub struct TimingReport {
     /// Multiresolution patches per level (level 0 first), last frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub patches_per_level: Option<Vec<u32>>,
+    /// Light patches evaluated per eye-space patch (and chosen by ISR).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub light_patches: Option<crate::debug_view::LightPatchStats>,
 }
 
 pub fn median(values: &[f64]) -> Option<f64> {
@@ -112,6 +115,7 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         indirect_gpu_ms_median: median(&frame_sum(true)),
         wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
         patches_per_level: stats.patches_per_level.clone(),
+        light_patches: None,
     }
 }
 

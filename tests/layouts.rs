@@ -1,7 +1,7 @@
 //! Host structs (`src/gpu_types.rs`) against the layouts glslang gave the
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
-use isr::gpu_types::{DrawPush, FrameUniforms, MaterialGpu};
+use isr::gpu_types::{DrawPush, FrameUniforms, LightPatch, MaterialGpu};
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
 
@@ -91,7 +91,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", hierarchy: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", light_levels: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -105,8 +105,19 @@ fn frame_uniforms_match_shared_glsl() {
             size => "size",
             refine => "refine",
             hierarchy => "hierarchy",
+            light_tree => "light_tree",
+            light_levels => "light_levels",
         ]);
     }
+}
+
+#[test]
+fn light_patch_matches_shared_glsl() {
+    check!("isr_select.comp", LightPatch, "LightPatch", flux: 16, [
+        position_area => "position_area",
+        normal => "normal",
+        flux => "flux",
+    ]);
 }
 
 #[test]
@@ -155,6 +166,24 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("GEO_HAS_GEOMETRY"), GEO_HAS_GEOMETRY);
     assert_eq!(value("GEO_SMOOTH"), GEO_SMOOTH);
     assert_eq!(value("GEO_SPLIT"), GEO_SPLIT);
+    let float = |name: &str| -> f32 {
+        let line = glsl
+            .lines()
+            .find(|l| l.contains(&format!(" {name} = ")))
+            .unwrap();
+        line.split('=')
+            .nth(1)
+            .unwrap()
+            .split(';')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(float("PATCH_EMPTY"), PATCH_EMPTY);
+    assert_eq!(float("PATCH_VALID"), PATCH_VALID);
+    assert_eq!(float("PATCH_INVALID"), PATCH_INVALID);
 }
 
 #[test]

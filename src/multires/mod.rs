@@ -71,6 +71,9 @@ pub struct MultiresBuffer {
     pub geo_flags: Image,
     /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.comp`).
     pub illumination: Image,
+    /// Light patches each eye-space patch evaluated (R32_UINT, layered like
+    /// the illumination buffer).
+    pub evaluations: Image,
     pub stencil: Image,
     /// Patches per level, counted by the refinement (host-visible).
     pub patch_counts: Buffer,
@@ -139,6 +142,13 @@ impl MultiresBuffer {
                 rgba,
                 storage | vk::ImageUsageFlags::COLOR_ATTACHMENT,
             )?,
+            evaluations: layered(
+                "evaluations",
+                vk::Format::R32_UINT,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::SAMPLED,
+            )?,
             stencil: layered(
                 "stencil",
                 stencil_format,
@@ -189,6 +199,7 @@ impl MultiresBuffer {
             &mut self.geo_max,
             &mut self.geo_flags,
             &mut self.illumination,
+            &mut self.evaluations,
             &mut self.stencil,
         ] {
             i.destroy(gpu);

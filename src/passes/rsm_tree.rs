@@ -1,6 +1,7 @@
 //! Pass `rsm-tree`: the RSM quadtree (ALGORITHM.md section 2, patches) in the
 //! mip chains of the RSM images, `shaders/rsm_tree.comp`, one dispatch per
-//! level, level k merging 2x2 texels of level k - 1.
+//! level, level k merging 2x2 texels of level k - 1 and flagging patches that
+//! span a discontinuity.
 //! Reads RSM mip 0; writes RSM mips 1.. (barriers below).
 
 use super::{ComputePass, FrameContext, INDIRECT_COMPUTE};
@@ -8,13 +9,13 @@ use crate::renderer::Targets;
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::Gpu;
+use crate::vk::{Buffer, Gpu};
 use anyhow::Result;
 
 pub struct RsmTreePass(ComputePass);
 
 impl RsmTreePass {
-    pub fn new(gpu: &Gpu, t: &Targets) -> Result<Self> {
+    pub fn new(gpu: &Gpu, uniforms: &Buffer, t: &Targets) -> Result<Self> {
         let images = [&t.rsm_position, &t.rsm_normal, &t.rsm_flux];
         let variants: Vec<Vec<Binding>> = (1..t.rsm_position.mips as usize)
             .map(|k| {
@@ -22,7 +23,10 @@ impl RsmTreePass {
                     .iter()
                     .map(|i| Binding::StorageImage(i.mip_views[k - 1]));
                 let dst = images.iter().map(|i| Binding::StorageImage(i.mip_views[k]));
-                src.chain(dst).collect()
+                std::iter::once(Binding::Uniform(uniforms))
+                    .chain(src)
+                    .chain(dst)
+                    .collect()
             })
             .collect();
         Ok(Self(ComputePass::new(

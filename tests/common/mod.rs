@@ -142,7 +142,7 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
         .expect("a multiresolution method");
     let uniforms = *r.uniforms();
     let total_area = r
-        .multires_gather
+        .gather_method
         .as_ref()
         .unwrap()
         .multires

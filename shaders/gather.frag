@@ -1,0 +1,154 @@
+#version 460
+// Stenciled gathering (ALGORITHM.md section 3, step 6): one draw over every
+// layer of the illumination buffer; the stencil test (EQUAL 1) runs before the
+// shader, so only patches are shaded. Each patch sums C_{j->i} / rho_i over its
+// light patches at its mean position and normal. Which light patches, is the
+// method (ALGORITHM.md section 4), chosen by LIGHT_PATCHES:
+//   0  regular N VPLs: level k of the RSM quadtree   (multires-gather)
+//   1  the list Basic ISR chose this frame            (isr)
+//   2  a per-fragment traversal of the quadtree       (hisr)
+// With the stencil off (a measurement baseline) every texel is shaded and
+// non-patches are masked afterwards.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
+#include "lighting.glsl"
+#include "multires.glsl"
+#include "vpl.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(constant_id = 0) const int LIGHT_PATCHES = 0;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
+layout(set = 0, binding = 1) uniform sampler2D geo_mean;    // mip chain
+layout(set = 0, binding = 2) uniform sampler2D geo_normal;  // mip chain
+layout(set = 0, binding = 3) uniform usampler2D geo_flags;  // mip chain
+layout(set = 0, binding = 4) uniform sampler2D rsm_position;  // quadtree (mip chain)
+layout(set = 0, binding = 5) uniform sampler2D rsm_normal;
+layout(set = 0, binding = 6) uniform sampler2D rsm_flux;
+layout(set = 0, binding = 7, std430) readonly buffer ChosenPatches {
+    uint patch_count;
+    uint pad0, pad1, pad2;
+    LightPatch patches[];
+};
+
+layout(location = 0) flat in int level;  // the layer (layered.vert)
+
+layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2); a: 1 = this texel is a patch
+layout(location = 1) out uint out_evaluations; // light patches evaluated
+
+vec3 e = vec3(0.0);
+uint evaluations = 0u;
+
+void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux) {
+    e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w);
+    evaluations += 1u;
+}
+
+void regular_vpls(vec3 xi, vec3 ni) {
+    int k = u.hierarchy.y;
+    int side = u.hierarchy.z;
+    bool point = (u.hierarchy.w & HIERARCHY_POINT_VPLS) != 0;
+    int span = 1 << k;  // RSM texels per VPL side
+    for (int y = 0; y < side; ++y) {
+        for (int x = 0; x < side; ++x) {
+            vec4 pos, nrm, flux;
+            if (point) {
+                // The texel at the patch's centre, standing for all 4^k texels.
+                ivec2 t = ivec2(x, y) * span + span / 2;
+                pos = texelFetch(rsm_position, t, 0);
+                nrm = texelFetch(rsm_normal, t, 0);
+                flux = texelFetch(rsm_flux, t, 0) * float(span * span);
+                pos.w *= float(span * span);
+            } else {
+                pos = texelFetch(rsm_position, ivec2(x, y), k);
+                nrm = texelFetch(rsm_normal, ivec2(x, y), k);
+                flux = texelFetch(rsm_flux, ivec2(x, y), k);
+            }
+            if (pos.w <= 0.0) continue;  // the patch saw nothing
+            add_patch(xi, ni, pos, nrm, flux.rgb);
+        }
+    }
+}
+
+void chosen_list(vec3 xi, vec3 ni) {
+    for (uint j = 0u; j < patch_count; ++j) {
+        LightPatch lp = patches[j];
+        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+    }
+}
+
+// Hierarchical ISR (ALGORITHM.md section 4): subdivide patch j while its
+// contribution to this receiver could exceed tau.
+//
+// The bound. With rho <= 1 and both cosines <= 1, Phi_j = rho_j I dw_j and
+// A_j = dw_j |V_j|^2 / cos_j >= dw_j |V_j|^2 (section 2) give
+//   C_{j->i} <= I dw_j / (pi |V_ij|^2 + dw_j |V_j|^2).
+// The talk takes one texel's solid angle as dw = 2 pi / (3 R^2) and scales by
+// |V_j|^2, which makes the bound independent of the light's distance and
+// gives its form: C <= 2 I |V_j|^2 / (3 R^2 |V_ij|^2 + 2 |V_j|^2). Requiring
+// it to exceed tau:
+//   subdivide j  iff  |V_ij|^2 <= T |V_j|^2,  T = 2 (I - tau) / (3 tau R^2),
+// constant per frame (light_tree.x; `--tau` is tau / I, so T = 2 (1 - tau) /
+// (3 tau R^2)). The per-level factor: a patch k levels above the finest stands
+// for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
+// R^2 / 4^k and its threshold 4^k T. Invalid patches (spanning a
+// discontinuity) are always subdivided.
+//
+// Depth-first with a fixed stack and no recursion; children are pushed only
+// above the max depth and when they fit, so every fetch is inside the quadtree
+// (a full stack evaluates the patch instead of splitting it).
+const int STACK_SIZE = 64;
+
+void traverse(vec3 xi, vec3 ni) {
+    int top = u.light_levels.w;  // mip of the single root patch
+    int start = u.light_levels.x;
+    int max_depth = u.light_levels.y;
+    float t_finest = u.light_tree.x;
+    vec3 light = u.light_position.xyz;
+    ivec3 stack[STACK_SIZE];  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
+    int side = 1 << start;
+    for (int s = 0; s < side * side; ++s) {
+        int sp = 0;
+        stack[sp++] = ivec3(s % side, s / side, start);
+        while (sp > 0) {
+            ivec3 node = stack[--sp];
+            int mip = top - node.z;
+            vec4 pos = texelFetch(rsm_position, node.xy, mip);
+            if (pos.w <= 0.0) continue;  // saw nothing
+            vec4 nrm = texelFetch(rsm_normal, node.xy, mip);
+            bool split = false;
+            if (node.z < max_depth && sp + 4 <= STACK_SIZE) {
+                vec3 vij = pos.xyz - xi;
+                vec3 vj = pos.xyz - light;
+                split = nrm.w == PATCH_INVALID || dot(vij, vij) <= exp2(float(2 * mip)) * t_finest * dot(vj, vj);
+            }
+            if (split) {
+                for (int i = 3; i >= 0; --i) stack[sp++] = ivec3(2 * node.xy + ivec2(i & 1, i >> 1), node.z + 1);
+            } else {
+                add_patch(xi, ni, pos, nrm, texelFetch(rsm_flux, node.xy, mip).rgb);
+            }
+        }
+    }
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec3 xi = texelFetch(geo_mean, p, level).xyz;
+    vec3 ni = texelFetch(geo_normal, p, level).xyz;
+    if (LIGHT_PATCHES == 0) {
+        regular_vpls(xi, ni);
+    } else if (LIGHT_PATCHES == 1) {
+        chosen_list(xi, ni);
+    } else {
+        traverse(xi, ni);
+    }
+    float is = 1.0;
+    if ((u.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(geo_flags, level, u.hierarchy.x, p)) {
+        is = 0.0;
+        e = vec3(0.0);
+        evaluations = 0u;
+    }
+    out_irradiance = vec4(e, is);
+    out_evaluations = evaluations;
+}

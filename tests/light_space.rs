@@ -1,0 +1,278 @@
+//! Light-space hierarchies: Basic ISR and Hierarchical ISR (ALGORITHM.md
+//! sections 2 and 4).
+mod common;
+
+use common::*;
+use glam::Vec3;
+use isr::multires::MultiresSettings;
+use isr::renderer::{LightTreeSettings, Method, RenderSettings};
+use isr::scene::{cornell::cornell_box, Camera};
+
+fn settings(method: Method, rsm: u32, light_tree: LightTreeSettings) -> RenderSettings {
+    RenderSettings {
+        width: 64,
+        height: 64,
+        rsm_resolution: rsm,
+        method,
+        light_tree,
+        multires: MultiresSettings::default(),
+        ..Default::default()
+    }
+}
+
+/// Relative RMSE of the indirect image over pixels with geometry.
+fn relative_rmse(a: &RenderedMultires, reference: &RenderedMultires) -> f64 {
+    let (mut err, mut norm) = (0.0, 0.0);
+    for (i, p) in reference.readback.position.iter().enumerate() {
+        if p[3] <= 0.0 {
+            continue;
+        }
+        let (x, r) = (
+            dvec(&a.readback.indirect[i]),
+            dvec(&reference.readback.indirect[i]),
+        );
+        err += (x - r).length_squared();
+        norm += r.length_squared();
+    }
+    (err / norm).sqrt()
+}
+
+#[test]
+fn hisr_converges_to_the_dense_gather_as_tau_falls() {
+    let gpu = gpu();
+    let scene = cornell_box();
+    let rsm = 64;
+    // Every RSM texel a VPL: the converged limit of the light-space choice.
+    let dense = render_multires(
+        &gpu,
+        &scene,
+        &RenderSettings {
+            vpls: rsm * rsm,
+            ..settings(Method::MultiresGather, rsm, LightTreeSettings::default())
+        },
+    );
+    let mut errors = Vec::new();
+    let mut evaluations = Vec::new();
+    for tau in [0.5, 0.1, 0.02, 0.004, 0.0008, 0.00001] {
+        let lt = LightTreeSettings {
+            tau,
+            max_depth: Some(6), // log2(64): down to single texels
+            ..Default::default()
+        };
+        let out = render_multires(&gpu, &scene, &settings(Method::Hisr, rsm, lt));
+        errors.push(relative_rmse(&out, &dense));
+        evaluations.push(isr::debug_view::light_patch_stats(&out.multires, None).per_patch_mean);
+    }
+    println!("tau sweep: relative RMSE {errors:?}, light patches per eye patch {evaluations:?}");
+    for w in errors.windows(2) {
+        assert!(w[1] <= w[0], "the error must fall as tau falls: {errors:?}");
+    }
+    for w in evaluations.windows(2) {
+        assert!(
+            w[1] >= w[0],
+            "smaller tau must evaluate more patches: {evaluations:?}"
+        );
+    }
+    assert!(
+        errors[0] > 0.01,
+        "the coarsest setting should be visibly approximate: {errors:?}"
+    );
+    assert!(
+        *errors.last().unwrap() < 1e-4,
+        "the finest setting should match the dense gather: {errors:?}"
+    );
+}
+
+#[test]
+fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
+    let gpu = gpu();
+    let scene = cornell_box();
+    let base = 16;
+    let no_merges = LightTreeSettings {
+        isr_base: base,
+        depth_threshold: 0.0,
+        normal_threshold_deg: 0.0,
+        ..Default::default()
+    };
+    let mut r =
+        isr::renderer::Renderer::new(&gpu, &scene, &settings(Method::Isr, 128, no_merges)).unwrap();
+    r.render_frames(1, |_| {}).unwrap();
+    let chosen = r.isr_chosen().unwrap().unwrap();
+    let isr_indirect = r.readback().unwrap().indirect;
+    drop(r);
+    assert_validation_clean(&gpu);
+    let regular = render_multires(
+        &gpu,
+        &scene,
+        &RenderSettings {
+            vpls: base * base,
+            ..settings(Method::MultiresGather, 128, LightTreeSettings::default())
+        },
+    );
+    let base_mip = (128 / base).ilog2() as f32;
+    assert!(
+        chosen.iter().all(|p| p.normal[3] == base_mip),
+        "every chosen patch is a base patch"
+    );
+    let non_empty = regular.multires.rsm_tree[base_mip as usize][0]
+        .iter()
+        .filter(|p| p[3] > 0.0)
+        .count();
+    assert_eq!(
+        chosen.len(),
+        non_empty,
+        "every non-empty base patch is chosen once"
+    );
+    for (i, (a, b)) in isr_indirect
+        .iter()
+        .zip(&regular.readback.indirect)
+        .enumerate()
+    {
+        let (a, b) = (dvec(a), dvec(b));
+        assert!(
+            (a - b).abs().max_element() <= 1e-5 * b.max_element() + 1e-8,
+            "pixel {i}: isr {a:?} vs regular {b:?}"
+        );
+    }
+}
+
+#[test]
+fn isr_chosen_patches_partition_the_rsm_flux() {
+    let gpu = gpu();
+    let s = settings(
+        Method::Isr,
+        128,
+        LightTreeSettings {
+            isr_base: 32,
+            ..Default::default()
+        },
+    );
+    let mut r = isr::renderer::Renderer::new(&gpu, &cornell_box(), &s).unwrap();
+    r.render_frames(1, |_| {}).unwrap();
+    let chosen = r.isr_chosen().unwrap().unwrap();
+    let rsm = r.readback().unwrap().rsm;
+    drop(r);
+    assert_validation_clean(&gpu);
+    let total: f64 = rsm.flux.iter().map(|f| (f[0] + f[1] + f[2]) as f64).sum();
+    let picked: f64 = chosen
+        .iter()
+        .map(|p| (p.flux[0] + p.flux[1] + p.flux[2]) as f64)
+        .sum();
+    assert!(
+        (picked - total).abs() <= 1e-4 * total,
+        "chosen flux {picked} vs RSM flux {total}"
+    );
+    let area: f64 = rsm.position.iter().map(|p| p[3] as f64).sum();
+    let picked_area: f64 = chosen.iter().map(|p| p.position_area[3] as f64).sum();
+    assert!(
+        (picked_area - area).abs() <= 1e-4 * area,
+        "chosen area {picked_area} vs RSM area {area}"
+    );
+    let base_mip = 2.0; // 128 / 32
+    let merged = chosen.iter().filter(|p| p.normal[3] > base_mip).count();
+    println!(
+        "{} patches chosen, {merged} of them merged above the base",
+        chosen.len()
+    );
+    assert!(
+        merged > 0 && chosen.len() < 32 * 32,
+        "flat walls should merge into larger patches"
+    );
+}
+
+/// Every output finite, with the light touching a wall, the camera inside a
+/// block, and receivers at zero distance from VPLs (surfaces the RSM sees).
+#[test]
+fn no_nan_or_inf_in_degenerate_configurations() {
+    let gpu = gpu();
+    let mut touching = cornell_box();
+    touching.light.position = Vec3::new(0.0, 1.0, -1.0); // on the back wall
+    touching.light.direction = Vec3::Z;
+    let mut inside = cornell_box();
+    inside.camera = Camera::look_at(
+        Vec3::new(-0.35, 0.6, -0.3),
+        Vec3::new(0.0, 0.6, 2.0),
+        Vec3::Y,
+        60f32.to_radians(),
+        0.01,
+    );
+    let mut grazing = cornell_box();
+    grazing.light.position = Vec3::new(0.0, 1e-4, 0.9); // just above the floor
+    grazing.light.direction = Vec3::new(0.0, 0.0, -1.0);
+    for (name, scene) in [
+        ("light on a wall", touching),
+        ("camera inside a block", inside),
+        ("light on the floor", grazing),
+    ] {
+        for method in [
+            Method::None,
+            Method::MultiresGather,
+            Method::Isr,
+            Method::Hisr,
+        ] {
+            let s = settings(method, 64, LightTreeSettings::default());
+            let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
+            r.render_frames(1, |_| {}).unwrap();
+            let rb = r.readback().unwrap();
+            let m = r.readback_multires().unwrap();
+            drop(r);
+            for (layer, data) in [
+                ("final", &rb.final_radiance),
+                ("direct", &rb.direct),
+                ("indirect", &rb.indirect),
+            ] {
+                assert!(
+                    data.iter().flatten().all(|v| v.is_finite()),
+                    "{name}, {}: non-finite values in {layer}",
+                    method.name()
+                );
+            }
+            if let Some(m) = m {
+                assert!(
+                    m.illumination
+                        .iter()
+                        .flatten()
+                        .flatten()
+                        .all(|v| v.is_finite()),
+                    "{name}, {}: illumination",
+                    method.name()
+                );
+            }
+        }
+    }
+    assert_validation_clean(&gpu);
+}
+
+#[test]
+fn stats_and_vpl_count_view_from_the_cli() {
+    let dir = std::env::temp_dir().join(format!("isr-hisr-cli-{}", std::process::id()));
+    let out = bin()
+        .args([
+            "render", "--method", "hisr", "--width", "64", "--height", "64", "--rsm", "64",
+            "--frames", "1",
+        ])
+        .args(["--stats", "--debug-view", "vpl-count"])
+        .arg("--png")
+        .arg(dir.join("h.png"))
+        .arg("--out")
+        .arg(dir.join("h.exr"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("light patches per eye-space patch: min"),
+        "{stdout}"
+    );
+    let heat = image::open(dir.join("h-vpl-count.png")).unwrap().to_rgb8();
+    let distinct: std::collections::HashSet<_> = heat.pixels().map(|p| p.0).collect();
+    assert!(
+        distinct.len() > 3,
+        "the heat map should vary over the image"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
