@@ -679,7 +679,7 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         }
         let m = &s.multires;
         let lt = &s.light_tree;
-        if !lt.isr_base.is_power_of_two() || lt.isr_base > r {
+        if s.method == Method::Isr && (!lt.isr_base.is_power_of_two() || lt.isr_base > r) {
             bail!(
                 "--isr-base {}: the base must be a power of 2 no larger than --rsm {r}",
                 lt.isr_base
