@@ -268,10 +268,10 @@ fn render(args: RenderArgs) -> Result<()> {
                 crate::debug_view::levels_png(m),
             ),
             (DebugView::VplCount, Some(m)) => {
-                let (rgba, max) = crate::debug_view::vpl_count_png(m);
+                let (rgba, min, max) = crate::debug_view::vpl_count_png(m);
                 (
                     "vpl-count",
-                    format!("light patches evaluated per pixel, black 0 to white {max}"),
+                    format!("light patches evaluated per pixel, black {min} to white {max}"),
                     rgba,
                 )
             }

@@ -115,8 +115,9 @@ pub fn light_patch_stats(m: &MultiresReadback, chosen: Option<u32>) -> LightPatc
 }
 
 /// Heat map of the light patches evaluated for each pixel's patch (black, red,
-/// yellow, white as the count rises to the maximum), and that maximum.
-pub fn vpl_count_png(m: &MultiresReadback) -> (Vec<u8>, u32) {
+/// yellow, white as the count rises from the image's minimum to its maximum;
+/// dark blue: no patch), with that minimum and maximum.
+pub fn vpl_count_png(m: &MultiresReadback) -> (Vec<u8>, u32, u32) {
     let w = m.width;
     let counts: Vec<Option<u32>> = patch_levels(m)
         .into_iter()
@@ -126,17 +127,19 @@ pub fn vpl_count_png(m: &MultiresReadback) -> (Vec<u8>, u32) {
             l.map(|l| m.evaluations[l as usize][((y >> l) * w + (x >> l)) as usize])
         })
         .collect();
-    let max = counts.iter().flatten().copied().max().unwrap_or(0).max(1);
+    let max = counts.iter().flatten().copied().max().unwrap_or(0);
+    let min = counts.iter().flatten().copied().min().unwrap_or(0);
+    let span = (max - min).max(1) as f32;
     let rgba = counts
         .iter()
         .flat_map(|c| match c {
             None => [0, 0, 64, 255],
             Some(c) => {
-                let t = *c as f32 / max as f32;
+                let t = (*c - min) as f32 / span;
                 let ramp = |a: f32| ((t * 3.0 - a).clamp(0.0, 1.0) * 255.0) as u8;
                 [ramp(0.0), ramp(1.0), ramp(2.0), 255]
             }
         })
         .collect();
-    (rgba, max)
+    (rgba, min, max)
 }

@@ -167,6 +167,8 @@ fn validation_with_synchronization_checks_is_silent_over_several_frames() {
         (Method::None, true),
         (Method::MultiresGather, true),
         (Method::MultiresGather, false),
+        (Method::Isr, true),
+        (Method::Hisr, true),
     ] {
         let mut settings = RenderSettings {
             width: 160,
