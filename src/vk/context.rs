@@ -302,11 +302,13 @@ impl Gpu {
             }
         };
         let instance = create_instance(&entry, validate)?;
-        // From here on, failures must destroy the instance; a guard keeps that simple.
-        let guard = InstanceGuard(Some(instance.clone()));
-
-        let mut validation_log = None;
-        let mut debug_utils = None;
+        // From here on, failures must destroy the messenger and the instance (in
+        // that order, before the log the messenger writes to); a guard does it.
+        let mut guard = InstanceGuard {
+            instance: Some(instance.clone()),
+            debug_utils: None,
+            validation_log: None,
+        };
         if validate {
             let log = Box::new(ValidationLog::default());
             let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
@@ -324,8 +326,8 @@ impl Gpu {
                 .user_data(&*log as *const ValidationLog as *mut c_void);
             let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
                 .context("creating the validation debug messenger")?;
-            debug_utils = Some((loader, messenger));
-            validation_log = Some(log);
+            guard.debug_utils = Some((loader, messenger));
+            guard.validation_log = Some(log);
         }
 
         let physical_devices = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
@@ -431,10 +433,13 @@ impl Gpu {
                 None,
             )
         }?;
+        // Success: the Gpu owns what the guard held.
+        guard.instance = None;
+        let debug_utils = guard.debug_utils.take();
+        let validation_log = guard.validation_log.take();
         let debug_device = debug_utils
             .as_ref()
             .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
-        std::mem::forget(guard);
         Ok(Self {
             entry,
             instance,
@@ -564,13 +569,24 @@ impl Drop for Gpu {
     }
 }
 
-/// Destroys the instance if device creation fails half-way.
-struct InstanceGuard(Option<ash::Instance>);
+/// Destroys the messenger and the instance if device creation fails half-way;
+/// the log is dropped after them (fields drop after `drop`).
+struct InstanceGuard {
+    instance: Option<ash::Instance>,
+    debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    validation_log: Option<Box<ValidationLog>>,
+}
 
 impl Drop for InstanceGuard {
     fn drop(&mut self) {
-        if let Some(i) = self.0.take() {
-            unsafe { i.destroy_instance(None) };
+        let Some(instance) = self.instance.take() else {
+            return;
+        };
+        unsafe {
+            if let Some((loader, messenger)) = self.debug_utils.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            instance.destroy_instance(None);
         }
     }
 }
