@@ -15,8 +15,8 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 
 // The layout every level of the RSM quadtree shares (see rsm_tree.comp).
-layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: A_j (m^2), 0 where nothing was seen
-layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: PATCH_VALID (1) where geometry was seen
+layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: A_j (m^2), 0 where nothing lit was seen
+layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: PATCH_VALID (1) where lit geometry was seen
 layout(location = 2) out vec4 out_flux;      // rgb: Phi_j (W); a: dw_j (sr)
 
 // Smallest cosine used for A_j: a surface seen edge-on by the light would get an
@@ -38,7 +38,12 @@ void main() {
     float cos_j = max(dot(n, to_light * inversesqrt(r2)), MIN_COS_J);
     vec3 albedo = material_albedo(draw.material, in_uv);
 
-    out_position = vec4(in_world, dw * r2 / cos_j);
-    out_normal = vec4(n, 1.0);
-    out_flux = vec4(albedo * spot_intensity(u, in_world) * dw, dw);
+    // Texels outside the cone (about 21% of a square RSM around a round cone)
+    // carry no power: they are empty patches, so no light-space method spends
+    // work on them and they do not pull the means of patches on the cone edge.
+    vec3 intensity = spot_intensity(u, in_world);
+    bool lit = max(intensity.r, max(intensity.g, intensity.b)) > 0.0;
+    out_position = vec4(in_world, lit ? dw * r2 / cos_j : 0.0);
+    out_normal = vec4(n, lit ? 1.0 : 0.0);
+    out_flux = vec4(albedo * intensity * dw, dw);
 }

@@ -6,8 +6,6 @@
 #include "shared.glsl"
 #include "multires.glsl"
 
-layout(constant_id = 0) const bool COUNT_PATCHES = true;
-
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
 layout(location = 0) flat in int level;  // the layer (layered.vert)
 layout(set = 0, binding = 1) uniform usampler2D geo_flags;
@@ -16,5 +14,5 @@ layout(set = 0, binding = 2, std430) buffer PatchCounts { uint patches_per_level
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     if (!is_patch(geo_flags, level, u.hierarchy.x, p)) discard;
-    if (COUNT_PATCHES) atomicAdd(patches_per_level[level], 1u);
+    atomicAdd(patches_per_level[level], 1u);
 }

@@ -74,6 +74,7 @@ vec3 interpolate(ivec2 p, vec3 fallback) {
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     bool all_valid = true;
+    vec3 lo = vec3(3.0e38), hi = vec3(0.0);
     for (int i = 0; i < 4; ++i) {
         ivec2 o = ivec2(i & 1, i >> 1);
         ivec2 q = clamped + o;
@@ -91,8 +92,13 @@ vec3 interpolate(ivec2 p, vec3 fallback) {
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
         sum += w * v.rgb;
         weight += w;
+        lo = min(lo, v.rgb);
+        hi = max(hi, v.rgb);
     }
-    if (all_valid) return sum;  // the weights sum to 1, extrapolating or not
+    // The weights sum to 1, extrapolating or not. An extrapolation (negative
+    // weights) can overshoot where the values vary steeply: irradiance is never
+    // negative, and it stays within one footprint range beyond the footprint.
+    if (all_valid) return clamp(sum, max(lo - (hi - lo), vec3(0.0)), hi + (hi - lo));
     if (clamped != base) return fallback;  // no extrapolation from a partial footprint
     // Renormalise over the texels that hold a value on the same surface; the
     // fractions are within 0..1 here, so the weights are non-negative.

@@ -114,8 +114,8 @@ struct RenderArgs {
     /// light patch is subdivided while its contribution could exceed tau * I.
     #[arg(long, default_value_t = 0.05)]
     tau: f32,
-    /// Light patches merge only when their distances to the light differ by
-    /// less than this fraction of the nearest.
+    /// Light patches merge only when each child lies within this fraction of
+    /// its distance to the light from the merged patch's plane.
     #[arg(long, default_value_t = 0.1)]
     light_depth_threshold: f32,
     /// ... and their normals by less than this angle (degrees).

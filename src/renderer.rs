@@ -396,6 +396,13 @@ impl SceneGpu {
                 limit
             );
         }
+        if scene.textures.len() > 1 && !gpu.features.sampled_image_array_indexing {
+            bail!(
+                "the scene has {} textures, but this device cannot index texture arrays \
+                 (shaderSampledImageArrayDynamicIndexing); use a scene with at most one texture",
+                scene.textures.len()
+            );
+        }
         let white = crate::scene::Texture {
             name: "white".into(),
             width: 1,
@@ -429,13 +436,6 @@ impl SceneGpu {
             slice_bytes(&materials),
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
-        if textures.len() > 1 && !gpu.features.sampled_image_array_indexing {
-            bail!(
-                "the scene has {} textures, but this device cannot index texture arrays \
-                 (shaderSampledImageArrayDynamicIndexing); use a scene with at most one texture",
-                textures.len()
-            );
-        }
         let views: Vec<vk::ImageView> = textures.iter().map(|t| t.view).collect();
         let set = DescriptorSet::new(
             gpu,
@@ -626,12 +626,14 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     let needed: u64 = target_list()
         .iter()
         .map(|(_, f, rsm, _)| {
-            let texels = if *rsm { (r as u64).pow(2) } else { s.width as u64 * s.height as u64 };
+            // RSM color images carry the quadtree: a mip chain, 4/3 the texels.
+            let texels = if *rsm { (r as u64).pow(2) * 4 / 3 } else { s.width as u64 * s.height as u64 };
             texels * texel_bytes(*f)
         })
         .sum::<u64>()
         // readback buffers for the largest layers
-        + s.width as u64 * s.height as u64 * 16 * 2;
+        + s.width as u64 * s.height as u64 * 16 * 2
+        + if s.method == Method::None { 0 } else { multires_bytes(s) };
     let props = unsafe {
         gpu.instance
             .get_physical_device_memory_properties(gpu.physical)
@@ -668,9 +670,9 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         }
         let levels = levels_of(s);
         if levels == 0
+            || levels >= crate::multires::MAX_LEVELS
             || s.width >> levels == 0
             || s.height >> levels == 0
-            || levels >= crate::multires::MAX_LEVELS
         {
             bail!(
                 "--levels {levels}: the coarsest level must be at least 1 and its texels ({0}x{0} pixels) no larger than the image",
@@ -713,6 +715,15 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// GPU memory of the multiresolution buffer: (L + 1) layers of illumination
+/// (RGBA32F), evaluation counts (R32UI) and stencil, plus five geometry mip
+/// chains (four RGBA32F, one R32UI).
+fn multires_bytes(s: &RenderSettings) -> u64 {
+    let pixels = s.width as u64 * s.height as u64;
+    let layers = levels_of(s).min(crate::multires::MAX_LEVELS) as u64 + 1;
+    layers * pixels * (16 + 4 + 4) + pixels * 4 / 3 * (4 * 16 + 4)
 }
 
 /// The RSM quadtree level (mip) Basic ISR starts from.
@@ -1168,9 +1179,11 @@ impl Renderer<'_> {
             return Ok(None);
         };
         let bytes = read_buffer(self.gpu, &isr.chosen)?;
-        let count = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
         let size = std::mem::size_of::<gpu_types::LightPatch>();
         let start = gpu_types::CHOSEN_PATCHES_HEADER;
+        // Clamped to the capacity: before any frame the count is not yet written.
+        let capacity = (bytes.len() - start) / size;
+        let count = (u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize).min(capacity);
         Ok(Some(
             bytes[start..start + count * size]
                 .chunks_exact(size)

@@ -242,3 +242,27 @@ fn no_vulkan_device_says_how_to_install_a_driver() {
         "the message should say how to install a driver:\n{stderr}"
     );
 }
+
+#[test]
+fn too_many_levels() {
+    let dir = temp_dir("levels");
+    let e = fails(
+        &dir,
+        &[
+            "--width", "32", "--height", "32", "--rsm", "32", "--levels", "40",
+        ],
+    );
+    assert!(e.contains("--levels 40"), "{e}");
+}
+
+#[test]
+fn vpls_not_a_power_of_four() {
+    let dir = temp_dir("vpls");
+    let e = fails(
+        &dir,
+        &[
+            "--width", "32", "--height", "32", "--rsm", "32", "--vpls", "200",
+        ],
+    );
+    assert!(e.contains("power of 4"), "{e}");
+}

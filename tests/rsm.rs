@@ -43,10 +43,19 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
         ..Default::default()
     };
     let rsm = render(&gpu, &scene, &settings, 1).readback.rsm;
+    // Every texel saw the floor (its solid angle is written wherever geometry
+    // was rasterized); exactly the texels the cone lights are non-empty patches.
     assert!(
-        rsm.normal.iter().all(|n| n[3] == 1.0),
+        rsm.flux.iter().all(|f| f[3] > 0.0),
         "some RSM texels saw no geometry"
     );
+    for (n, f) in rsm.normal.iter().zip(&rsm.flux) {
+        assert_eq!(
+            n[3] == 1.0,
+            f[0] > 0.0,
+            "lit texels and only they are patches"
+        );
+    }
 
     let flux: f64 = rsm.flux.iter().map(|f| f[0] as f64).sum();
     let expected = expected_flux(&light, rho as f64);
@@ -66,9 +75,9 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
         "sum of dw {omega} vs {omega_expected}"
     );
 
-    // Areas: the texels tile the floor's square under the frustum, (2 h tan a)^2.
+    // Areas: the lit texels tile the floor's disc under the cone, pi (h tan a)^2.
     let area: f64 = rsm.position.iter().map(|p| p[3] as f64).sum();
-    let area_expected = (2.0 * height as f64 * a.tan()).powi(2);
+    let area_expected = std::f64::consts::PI * (height as f64 * a.tan()).powi(2);
     assert!(
         (area - area_expected).abs() < 0.01 * area_expected,
         "sum of A_j {area} vs {area_expected}"

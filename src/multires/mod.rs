@@ -92,6 +92,23 @@ impl MultiresBuffer {
                     | vk::FormatFeatureFlags::TRANSFER_SRC,
             )
             .ok_or_else(|| anyhow!("the device has no stencil format usable as an attachment"))?;
+        // geometry_mips.comp binds ten storage images (Vulkan guarantees four per
+        // stage), and the refinement counts patches with fragment-shader atomics.
+        let storage_images = gpu.limits().max_per_stage_descriptor_storage_images;
+        if storage_images < 10 {
+            bail!(
+                "{} allows {storage_images} storage images per shader stage; the geometry mips need 10. \
+                 Choose another --device or --method none",
+                gpu.info.name
+            );
+        }
+        if !gpu.features.fragment_atomics {
+            bail!(
+                "{} lacks fragmentStoresAndAtomics, which the stenciled refinement needs; \
+                 choose another --device or --method none",
+                gpu.info.name
+            );
+        }
         if !gpu.features.shader_output_layer {
             bail!(
                 "{} cannot choose the layer in a vertex shader (Vulkan 1.2 shaderOutputLayer), \

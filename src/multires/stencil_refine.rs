@@ -45,7 +45,6 @@ impl StencilRefinePass {
                 set_layouts: &[set.layout],
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::WRITE_ONE),
-                specialization: &[(0, gpu.features.fragment_atomics as i32)],
                 ..Default::default()
             },
         )?;
@@ -63,7 +62,16 @@ impl StencilRefinePass {
                 Use::DISCARD_AFTER_STENCIL_READERS,
                 Use::STENCIL_ATTACHMENT,
             );
-            // The counts were read by the host after the previous frame's fence.
+            // The previous frame's atomics are done before the counts are reset
+            // (the host read them after that frame's fence).
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            );
             d.cmd_fill_buffer(cmd, m.patch_counts.buffer, 0, vk::WHOLE_SIZE, 0);
             barrier::memory(
                 gpu,
