@@ -1099,14 +1099,7 @@ pub fn read_regions(gpu: &Gpu, regions: &[Region]) -> Result<Vec<Vec<u8>>> {
             .map(|(i, from)| barrier::image(i, Use::TRANSFER_SRC, *from))
             .collect();
         barrier::images(gpu, cmd, &back);
-        barrier::memory(
-            gpu,
-            cmd,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        barrier::copies_to_host(gpu, cmd);
     });
     let out = buffers.iter().map(|b| b.mapped().to_vec()).collect();
     for mut b in buffers {
@@ -1131,14 +1124,7 @@ pub fn read_buffer(gpu: &Gpu, buffer: &Buffer) -> Result<Vec<u8>> {
             staging.buffer,
             &[vk::BufferCopy::default().size(buffer.size)],
         );
-        barrier::memory(
-            gpu,
-            cmd,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        barrier::copies_to_host(gpu, cmd);
     });
     let bytes = staging.mapped().to_vec();
     staging.destroy(gpu);

@@ -174,6 +174,18 @@ pub fn compute_to_compute(gpu: &Gpu, cmd: vk::CommandBuffer) {
     );
 }
 
+/// Makes copies into host-visible buffers readable by the host after the fence.
+pub fn copies_to_host(gpu: &Gpu, cmd: vk::CommandBuffer) {
+    memory(
+        gpu,
+        cmd,
+        vk::PipelineStageFlags2::COPY,
+        vk::AccessFlags2::TRANSFER_WRITE,
+        vk::PipelineStageFlags2::HOST,
+        vk::AccessFlags2::HOST_READ,
+    );
+}
+
 /// A global memory barrier (buffers, host visibility).
 pub fn memory(
     gpu: &Gpu,
