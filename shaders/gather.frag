@@ -32,10 +32,12 @@ layout(set = 0, binding = 7, std430) readonly buffer ChosenPatches {
     LightPatch patches[];
 };
 
+#include "regular_vpls.glsl"
+
 layout(location = 0) flat in int level;  // the layer (layered.vert)
 
 layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2); a: 1 = this texel is a patch
-layout(location = 1) out uint out_evaluations; // light patches evaluated
+layout(location = 1) out float out_evaluations; // light patches evaluated (a count, R32F so splats can add)
 
 vec3 e = vec3(0.0);
 uint evaluations = 0u;
@@ -46,28 +48,10 @@ void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux) {
 }
 
 void regular_vpls(vec3 xi, vec3 ni) {
-    int k = u.hierarchy.y;
-    int side = u.hierarchy.z;
-    bool point = (u.hierarchy.w & HIERARCHY_POINT_VPLS) != 0;
-    int span = 1 << k;  // RSM texels per VPL side
-    for (int y = 0; y < side; ++y) {
-        for (int x = 0; x < side; ++x) {
-            vec4 pos, nrm, flux;
-            if (point) {
-                // The texel at the patch's centre, standing for all 4^k texels.
-                ivec2 t = ivec2(x, y) * span + span / 2;
-                pos = texelFetch(rsm_position, t, 0);
-                nrm = texelFetch(rsm_normal, t, 0);
-                flux = texelFetch(rsm_flux, t, 0) * float(span * span);
-                pos.w *= float(span * span);
-            } else {
-                pos = texelFetch(rsm_position, ivec2(x, y), k);
-                nrm = texelFetch(rsm_normal, ivec2(x, y), k);
-                flux = texelFetch(rsm_flux, ivec2(x, y), k);
-            }
-            if (pos.w <= 0.0) continue;  // the patch saw nothing
-            add_patch(xi, ni, pos, nrm, flux.rgb);
-        }
+    for (int j = 0; j < regular_vpl_count(); ++j) {
+        vec4 pos, nrm;
+        vec3 flux;
+        if (regular_vpl(j, pos, nrm, flux)) add_patch(xi, ni, pos, nrm, flux);
     }
 }
 
@@ -150,5 +134,5 @@ void main() {
         evaluations = 0u;
     }
     out_irradiance = vec4(e, is);
-    out_evaluations = evaluations;
+    out_evaluations = float(evaluations);
 }

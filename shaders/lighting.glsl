@@ -2,8 +2,6 @@
 #ifndef LIGHTING_GLSL
 #define LIGHTING_GLSL
 
-const float PI = 3.14159265358979323846;
-
 // Radiant intensity (W/sr) of the spot light toward world point p, per channel:
 // KHR_lights_punctual angular attenuation (squared smooth ramp between the
 // cones) and, when a range is set, the extension's range window.

@@ -30,7 +30,10 @@ struct FrameUniforms {
                             // threshold (cosine); w: I, the light's peak intensity (W/sr)
     ivec4 light_levels;     // x: HISR start depth (2^x x 2^x patches); y: HISR max depth;
                             // z: ISR base level (RSM mip); w: log2 R, the top mip (one patch)
+    vec4 splat;             // x: restricted-splat threshold (irradiance, W/m^2)
 };
+
+const float PI = 3.14159265358979323846;
 
 // One light patch chosen by Basic ISR (a node of the RSM quadtree).
 struct LightPatch {

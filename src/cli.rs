@@ -121,6 +121,10 @@ struct RenderArgs {
     /// ... and their normals by less than this angle (degrees).
     #[arg(long, default_value_t = 30.0)]
     light_normal_threshold: f32,
+    /// Restricted splats: a VPL's quad covers only where its irradiance bound
+    /// Phi / (pi d^2) exceeds this (W/m^2); 0 gives full-screen splats.
+    #[arg(long, default_value_t = 0.01)]
+    splat_threshold: f32,
     /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
     /// patch, `indirect` shows the indirect light alone, `vpl-count` is a heat
     /// map of the light patches evaluated per pixel. Repeatable.
@@ -223,6 +227,7 @@ fn render(args: RenderArgs) -> Result<()> {
             max_depth: Some(args.max_depth.unwrap_or(6.min(args.rsm.max(1).ilog2()))),
             tau: args.tau,
         },
+        splat_threshold: args.splat_threshold,
         ..RenderSettings::default()
     };
     eprintln!(

@@ -34,6 +34,8 @@ pub struct FrameUniforms {
     pub light_tree: [f32; 4],
     /// x: HISR start depth; y: HISR max depth; z: ISR base mip; w: log2 R.
     pub light_levels: [i32; 4],
+    /// x: restricted-splat threshold (W/m^2).
+    pub splat: [f32; 4],
 }
 
 /// `LightPatch` (std430): one patch chosen by Basic ISR.

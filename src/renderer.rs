@@ -3,6 +3,9 @@
 
 use crate::gpu_types::{self, bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
 use crate::methods::gather::GatherMethod;
+use crate::methods::rsm_gather::RsmGatherPass;
+use crate::methods::rsm_splat::RsmSplatPass;
+use crate::methods::FullResolution;
 use crate::multires::{MultiresSettings, Upsample};
 use crate::passes::rsm_tree::RsmTreePass;
 use crate::passes::{
@@ -32,6 +35,14 @@ pub enum Method {
     Isr,
     /// Hierarchical ISR: a per-fragment traversal of the RSM quadtree.
     Hisr,
+    /// Every full-resolution pixel gathers N regular VPLs.
+    RsmGather,
+    /// Each VPL splats a full-screen quad, additively.
+    RsmSplat,
+    /// Each VPL splats a quad bounded to where it can exceed --splat-threshold.
+    RsmSplatRestricted,
+    /// Each VPL splats into every patch of the multiresolution buffer.
+    MultiresSplat,
 }
 
 impl Method {
@@ -41,7 +52,19 @@ impl Method {
             Method::MultiresGather => "multires-gather",
             Method::Isr => "isr",
             Method::Hisr => "hisr",
+            Method::RsmGather => "rsm-gather",
+            Method::RsmSplat => "rsm-splat",
+            Method::RsmSplatRestricted => "rsm-splat-restricted",
+            Method::MultiresSplat => "multires-splat",
         }
+    }
+
+    /// Whether the method goes through the multiresolution buffer.
+    pub fn uses_multires(self) -> bool {
+        matches!(
+            self,
+            Method::MultiresGather | Method::Isr | Method::Hisr | Method::MultiresSplat
+        )
     }
 }
 
@@ -109,6 +132,8 @@ pub struct RenderSettings {
     pub vpl_sampling: VplSampling,
     pub multires: MultiresSettings,
     pub light_tree: LightTreeSettings,
+    /// Restricted splats skip where a VPL's irradiance bound is below this (W/m^2).
+    pub splat_threshold: f32,
 }
 
 impl Default for RenderSettings {
@@ -127,6 +152,7 @@ impl Default for RenderSettings {
             vpl_sampling: VplSampling::Mean,
             multires: MultiresSettings::default(),
             light_tree: LightTreeSettings::default(),
+            splat_threshold: 0.01,
         }
     }
 }
@@ -584,8 +610,10 @@ pub struct Renderer<'g> {
     composite: CompositePass,
     tonemap: TonemapPass,
     rsm_tree: Option<RsmTreePass>,
-    /// The method's passes (`None` for method `none`).
+    /// The passes of a method that gathers into the multiresolution buffer.
     pub gather_method: Option<GatherMethod>,
+    /// The pass of a full-resolution method.
+    full_resolution: Option<FullResolution>,
     profiler: Profiler,
     frame_cmd: vk::CommandBuffer,
 }
@@ -633,7 +661,7 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         .sum::<u64>()
         // readback buffers for the largest layers
         + s.width as u64 * s.height as u64 * 16 * 2
-        + if s.method == Method::None { 0 } else { multires_bytes(s) };
+        + if s.method.uses_multires() { multires_bytes(s) } else { 0 };
     let props = unsafe {
         gpu.instance
             .get_physical_device_memory_properties(gpu.physical)
@@ -655,6 +683,9 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     }
     if !(s.exposure.is_finite() && s.exposure >= 0.0) {
         bail!("--exposure must be a finite non-negative number");
+    }
+    if !(s.splat_threshold.is_finite() && s.splat_threshold >= 0.0) {
+        bail!("--splat-threshold must be a finite non-negative irradiance (W/m^2)");
     }
     if s.method != Method::None {
         let side = (s.vpls as f64).sqrt() as u32;
@@ -805,6 +836,7 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
             lt.normal_threshold_deg.to_radians().cos(),
             (l.color * l.intensity).max_element(),
         ],
+        splat: [s.splat_threshold, 0.0, 0.0, 0.0],
         light_levels: [
             lt.start_level as i32,
             lt.max_depth.unwrap_or(top) as i32,
@@ -839,17 +871,27 @@ impl<'g> Renderer<'g> {
             Method::None => None,
             _ => Some(RsmTreePass::new(gpu, &uniforms, &targets)?),
         };
-        let gather_method = match settings.method {
-            Method::None => None,
-            _ => Some(GatherMethod::new(
-                gpu,
-                &FrameInputs {
-                    uniforms: &uniforms,
-                    targets: &targets,
-                    samplers: &samplers,
-                },
-                settings,
-            )?),
+        let inputs = FrameInputs {
+            uniforms: &uniforms,
+            targets: &targets,
+            samplers: &samplers,
+        };
+        let gather_method = if settings.method.uses_multires() {
+            Some(GatherMethod::new(gpu, &inputs, settings)?)
+        } else {
+            None
+        };
+        let full_resolution = match settings.method {
+            Method::RsmGather => Some(FullResolution::Gather(RsmGatherPass::new(gpu, &inputs)?)),
+            Method::RsmSplat | Method::RsmSplatRestricted => {
+                Some(FullResolution::Splat(RsmSplatPass::new(
+                    gpu,
+                    &inputs,
+                    settings.vpls,
+                    settings.method == Method::RsmSplatRestricted,
+                )?))
+            }
+            _ => None,
         };
         let profiler = Profiler::new(gpu, MAX_PASSES)?;
         let frame_cmd = gpu.allocate_command_buffer()?;
@@ -868,6 +910,7 @@ impl<'g> Renderer<'g> {
             tonemap,
             rsm_tree,
             gather_method,
+            full_resolution,
             profiler,
             frame_cmd,
         };
@@ -929,6 +972,9 @@ impl<'g> Renderer<'g> {
         }
         // Method `none`: indirect stays zero (cleared once in `new`).
         if let Some(m) = &self.gather_method {
+            m.record(&ctx, p);
+        }
+        if let Some(m) = &self.full_resolution {
             m.record(&ctx, p);
         }
         self.composite.record(&ctx, p);
@@ -1223,7 +1269,15 @@ impl Renderer<'_> {
         let illumination: Vec<_> = (0..n)
             .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
             .collect();
-        let evaluations: Vec<Vec<u32>> = (0..n).map(|_| to_u32(&raw.next().unwrap())).collect();
+        // Counts stored as f32 (exact below 2^24).
+        let evaluations: Vec<Vec<u32>> = (0..n)
+            .map(|_| {
+                to_u32(&raw.next().unwrap())
+                    .into_iter()
+                    .map(|b| f32::from_bits(b) as u32)
+                    .collect()
+            })
+            .collect();
         let stencil: Vec<Vec<u8>> = (0..n).map(|_| raw.next().unwrap()).collect();
         let geo_mean: Vec<_> = (0..n)
             .map(|_| to_rgba_f32(&raw.next().unwrap(), rgba))
@@ -1267,6 +1321,9 @@ impl Drop for Renderer<'_> {
             t.destroy(gpu);
         }
         if let Some(m) = &mut self.gather_method {
+            m.destroy(gpu);
+        }
+        if let Some(m) = &mut self.full_resolution {
             m.destroy(gpu);
         }
         self.profiler.destroy(gpu);

@@ -91,7 +91,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", light_levels: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", splat: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -107,6 +107,7 @@ fn frame_uniforms_match_shared_glsl() {
             hierarchy => "hierarchy",
             light_tree => "light_tree",
             light_levels => "light_levels",
+            splat => "splat",
         ]);
     }
 }

@@ -7,6 +7,7 @@
 //! ([`LightPatches`]); [`GatherMethod`] puts the method's passes in order.
 
 use super::isr::IsrSelectPass;
+use super::multires_splat::MultiresSplatPass;
 use crate::multires::{Multires, MultiresBuffer};
 use crate::passes::{
     begin_rendering, Attachments, FrameContext, StencilAttachment, INDIRECT_GRAPHICS,
@@ -127,14 +128,20 @@ impl GatherPass {
     }
 }
 
-/// A method that gathers into the multiresolution buffer: `multires-gather`,
-/// `isr` and `hisr`. Geometry mips and stencil refinement, the method's own
-/// light-space passes, the gather, then upsampling.
+/// What fills the multiresolution buffer's patches.
+enum Fill {
+    Gather(GatherPass),
+    Splat(MultiresSplatPass),
+}
+
+/// A method that works through the multiresolution buffer: `multires-gather`,
+/// `isr`, `hisr` and `multires-splat`. Geometry mips and stencil refinement,
+/// the method's own light-space passes, the gather (or splat), then upsampling.
 pub struct GatherMethod {
     pub multires: Multires,
     /// Basic ISR's patch selection (method `isr` only).
     pub isr: Option<IsrSelectPass>,
-    gather: GatherPass,
+    fill: Fill,
     /// Bound for methods without a chosen list (the descriptor needs a buffer).
     placeholder: Option<Buffer>,
 }
@@ -173,12 +180,28 @@ impl GatherMethod {
             .map(|i| &i.chosen)
             .or(placeholder.as_ref())
             .unwrap();
-        let stencil = settings.multires.stencil;
-        let gather = GatherPass::new(gpu, inputs, &multires.buffer, source, chosen, stencil)?;
+        let fill = if method == Method::MultiresSplat {
+            Fill::Splat(MultiresSplatPass::new(
+                gpu,
+                inputs,
+                &multires.buffer,
+                settings.vpls,
+            )?)
+        } else {
+            let stencil = settings.multires.stencil;
+            Fill::Gather(GatherPass::new(
+                gpu,
+                inputs,
+                &multires.buffer,
+                source,
+                chosen,
+                stencil,
+            )?)
+        };
         Ok(Self {
             multires,
             isr,
-            gather,
+            fill,
             placeholder,
         })
     }
@@ -188,12 +211,18 @@ impl GatherMethod {
         if let Some(isr) = &self.isr {
             isr.record(ctx, p);
         }
-        self.gather.record(ctx, p, &self.multires.buffer);
+        match &self.fill {
+            Fill::Gather(g) => g.record(ctx, p, &self.multires.buffer),
+            Fill::Splat(s) => s.record(ctx, p, &self.multires.buffer),
+        }
         self.multires.record_upsample(ctx, p);
     }
 
     pub fn destroy(&mut self, gpu: &Gpu) {
-        self.gather.destroy(gpu);
+        match &mut self.fill {
+            Fill::Gather(g) => g.destroy(gpu),
+            Fill::Splat(s) => s.destroy(gpu),
+        }
         if let Some(i) = &mut self.isr {
             i.destroy(gpu);
         }

@@ -71,8 +71,8 @@ pub struct MultiresBuffer {
     pub geo_flags: Image,
     /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.comp`).
     pub illumination: Image,
-    /// Light patches each eye-space patch evaluated (R32_UINT, layered like
-    /// the illumination buffer).
+    /// Light patches each eye-space patch evaluated (a count in R32_SFLOAT, so
+    /// splats can add it up; layered like the illumination buffer).
     pub evaluations: Image,
     pub stencil: Image,
     /// Patches per level, counted by the refinement (host-visible).
@@ -161,7 +161,7 @@ impl MultiresBuffer {
             )?,
             evaluations: layered(
                 "evaluations",
-                vk::Format::R32_UINT,
+                vk::Format::R32_SFLOAT,
                 vk::ImageUsageFlags::COLOR_ATTACHMENT
                     | vk::ImageUsageFlags::TRANSFER_SRC
                     | vk::ImageUsageFlags::SAMPLED,

@@ -267,6 +267,18 @@ impl FullscreenPass {
         bindings: &[Binding],
         color_formats: &[vk::Format],
     ) -> Result<Self> {
+        Self::with_push_constants(gpu, name, fragment_shader, bindings, color_formats, 0)
+    }
+
+    /// As `new`, with `push_constant_bytes` of push constants for `record_with`.
+    pub fn with_push_constants(
+        gpu: &Gpu,
+        name: &str,
+        fragment_shader: &str,
+        bindings: &[Binding],
+        color_formats: &[vk::Format],
+        push_constant_bytes: u32,
+    ) -> Result<Self> {
         let set = DescriptorSet::new(gpu, name, bindings)?;
         let pipeline = Pipeline::graphics(
             gpu,
@@ -275,6 +287,7 @@ impl FullscreenPass {
                 vertex_shader: "fullscreen.vert",
                 fragment_shader,
                 set_layouts: &[set.layout],
+                push_constant_bytes,
                 color_formats,
                 ..Default::default()
             },
@@ -284,6 +297,11 @@ impl FullscreenPass {
 
     /// Writes every pixel of `outputs`, with the convention's barriers.
     pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer, outputs: &[&Image]) {
+        self.record_with(gpu, cmd, outputs, &[]);
+    }
+
+    /// As `record`, with push constants.
+    pub fn record_with(&self, gpu: &Gpu, cmd: vk::CommandBuffer, outputs: &[&Image], push: &[u8]) {
         barrier::transition(
             gpu,
             cmd,
@@ -301,6 +319,15 @@ impl FullscreenPass {
         unsafe {
             self.pipeline
                 .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+            if !push.is_empty() {
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline.layout,
+                    vk::ShaderStageFlags::ALL_GRAPHICS,
+                    0,
+                    push,
+                );
+            }
             d.cmd_draw(cmd, 3, 1, 0, 0);
             d.cmd_end_rendering(cmd);
         }

@@ -11,10 +11,11 @@ use super::resources::Image;
 use super::Gpu;
 use ash::vk;
 
-/// Every stage that may read a finished pass output: fragment and compute
-/// shaders, and the readback copy.
+/// Every stage that may read a finished pass output: vertex (splats fetch
+/// their VPL there), fragment and compute shaders, and the readback copy.
 pub const READERS: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
-    vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
+    vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
+        | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
         | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
         | vk::PipelineStageFlags2::COPY.as_raw(),
 );

@@ -211,8 +211,8 @@ pub struct GraphicsDesc<'a> {
     /// A stencil attachment of this format with this test (`UNDEFINED`: none).
     pub stencil_format: vk::Format,
     pub stencil: Option<StencilTest>,
-    /// Additive blending (`ONE + ONE`) on every color attachment.
-    pub additive: bool,
+    /// Blending on every color attachment.
+    pub blend: Blend,
     /// Cull mode is set per draw (glTF `doubleSided`), so it is dynamic state.
     pub dynamic_cull: bool,
     /// Integer specialization constants, by constant id.
@@ -233,11 +233,22 @@ impl Default for GraphicsDesc<'_> {
             depth_test: None,
             stencil_format: vk::Format::UNDEFINED,
             stencil: None,
-            additive: false,
+            blend: Blend::None,
             dynamic_cull: false,
             specialization: &[],
         }
     }
+}
+
+/// How fragments combine with what the attachment holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Overwrite.
+    None,
+    /// `dst + src` in every channel (splatting).
+    Additive,
+    /// `dst + src` in color, `max(dst, src)` in alpha (splatting a flag).
+    AdditiveAlphaMax,
 }
 
 /// Stencil state for front and back faces alike; the reference is 1.
@@ -345,17 +356,18 @@ impl Pipeline {
             .map(|_| {
                 let b = vk::PipelineColorBlendAttachmentState::default()
                     .color_write_mask(vk::ColorComponentFlags::RGBA);
-                if desc.additive {
-                    b.blend_enable(true)
-                        .src_color_blend_factor(vk::BlendFactor::ONE)
-                        .dst_color_blend_factor(vk::BlendFactor::ONE)
-                        .color_blend_op(vk::BlendOp::ADD)
-                        .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                        .alpha_blend_op(vk::BlendOp::ADD)
-                } else {
-                    b
-                }
+                let alpha_op = match desc.blend {
+                    Blend::None => return b,
+                    Blend::Additive => vk::BlendOp::ADD,
+                    Blend::AdditiveAlphaMax => vk::BlendOp::MAX,
+                };
+                b.blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ONE)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(alpha_op)
             })
             .collect();
         let blend =

@@ -1,0 +1,28 @@
+#version 460
+// One VPL's irradiance at one patch of the multiresolution buffer (its mean
+// position and normal), added by the blend state (color ONE + ONE, alpha MAX,
+// so alpha = 1 marks the patches as the gather does). See multires_splat.vert.
+#extension GL_GOOGLE_include_directive : require
+#include "shared.glsl"
+#include "vpl.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(set = 0, binding = 1) uniform sampler2D geo_mean;    // mip chain
+layout(set = 0, binding = 2) uniform sampler2D geo_normal;  // mip chain
+
+layout(location = 0) flat in int level;
+layout(location = 1) flat in vec4 in_position;
+layout(location = 2) flat in vec3 in_normal;
+layout(location = 3) flat in vec3 in_flux;
+
+layout(location = 0) out vec4 out_irradiance;
+layout(location = 1) out float out_evaluations;  // one per splat
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec3 xi = texelFetch(geo_mean, p, level).xyz;
+    vec3 ni = texelFetch(geo_normal, p, level).xyz;
+    out_irradiance = vec4(patch_irradiance(xi, ni, in_position.xyz, in_normal, in_flux, in_position.w), 1.0);
+    out_evaluations = 1.0;
+}

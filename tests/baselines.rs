@@ -1,0 +1,125 @@
+//! The baselines of ALGORITHM.md section 5 compute the same sums in different
+//! orders, on the same RSM, scene and composite.
+mod common;
+
+use common::*;
+use isr::multires::MultiresSettings;
+use isr::renderer::{Method, RenderSettings, Renderer};
+use isr::scene::cornell::cornell_box;
+
+fn settings(method: Method) -> RenderSettings {
+    RenderSettings {
+        width: 96,
+        height: 80,
+        rsm_resolution: 64,
+        vpls: 64,
+        method,
+        ..Default::default()
+    }
+}
+
+fn indirect_of(
+    gpu: &isr::vk::Gpu,
+    s: &RenderSettings,
+) -> (Vec<[f32; 4]>, Vec<isr::vk::profiler::PassSample>) {
+    let mut r = Renderer::new(gpu, &cornell_box(), s).unwrap();
+    let stats = r.render_frames(1, |_| {}).unwrap();
+    let out = r.readback().unwrap();
+    drop(r);
+    assert_validation_clean(gpu);
+    (out.indirect, stats.frames.into_iter().next().unwrap())
+}
+
+/// Largest difference relative to the larger value (with a floor for zeros).
+fn assert_same(name: &str, a: &[[f32; 4]], b: &[[f32; 4]], tolerance: f64) {
+    let scale = b
+        .iter()
+        .flat_map(|p| &p[..3])
+        .fold(0.0f64, |m, &v| m.max(v as f64));
+    assert!(scale > 0.0, "{name}: the reference is black");
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        for k in 0..3 {
+            let (x, y) = (x[k] as f64, y[k] as f64);
+            assert!(
+                (x - y).abs() <= tolerance * x.abs().max(y.abs()) + 1e-6 * scale,
+                "{name}: pixel {i} channel {k}: {x} vs {y}"
+            );
+        }
+    }
+}
+
+#[test]
+fn rsm_gather_rsm_splat_and_level_zero_multires_gather_agree() {
+    let gpu = gpu();
+    let (gather, _) = indirect_of(&gpu, &settings(Method::RsmGather));
+    let (splat, _) = indirect_of(&gpu, &settings(Method::RsmSplat));
+    let level_zero = RenderSettings {
+        multires: MultiresSettings {
+            depth_threshold: 0.0,
+            normal_threshold_deg: 0.0,
+            ..Default::default()
+        },
+        ..settings(Method::MultiresGather)
+    };
+    let (multires, _) = indirect_of(&gpu, &level_zero);
+    assert_same("rsm-splat vs rsm-gather", &splat, &gather, 1e-5);
+    assert_same(
+        "multires-gather at level 0 vs rsm-gather",
+        &multires,
+        &gather,
+        1e-5,
+    );
+}
+
+#[test]
+fn restricted_splats_with_threshold_zero_equal_full_splats() {
+    let gpu = gpu();
+    let (full, full_stats) = indirect_of(&gpu, &settings(Method::RsmSplat));
+    let restricted = |t| RenderSettings {
+        splat_threshold: t,
+        ..settings(Method::RsmSplatRestricted)
+    };
+    let (zero, zero_stats) = indirect_of(&gpu, &restricted(0.0));
+    assert_eq!(zero, full, "threshold 0 draws every splat full screen");
+    let fragments = |s: &[isr::vk::profiler::PassSample]| {
+        s.iter()
+            .find(|p| p.name == "rsm-splat")
+            .unwrap()
+            .samples_passed
+            .unwrap()
+    };
+    assert_eq!(fragments(&zero_stats), fragments(&full_stats));
+    // A positive threshold shades fewer fragments and drops only small terms.
+    let (cut, cut_stats) = indirect_of(&gpu, &restricted(0.05));
+    assert!(
+        fragments(&cut_stats) < fragments(&full_stats) / 2,
+        "{} vs {}",
+        fragments(&cut_stats),
+        fragments(&full_stats)
+    );
+    let (mut err, mut norm) = (0.0, 0.0);
+    for (a, b) in cut.iter().zip(&full) {
+        for k in 0..3 {
+            assert!(
+                a[k] <= b[k] * (1.0 + 1e-5) + 1e-9,
+                "restricting can only drop contributions"
+            );
+            err += ((a[k] - b[k]) as f64).powi(2);
+            norm += (b[k] as f64).powi(2);
+        }
+    }
+    let rel = (err / norm).sqrt();
+    assert!(
+        rel > 0.0 && rel < 0.5,
+        "restricted splats at 0.05 W/m^2 differ by {rel}"
+    );
+}
+
+#[test]
+fn multires_splat_equals_multires_gather() {
+    let gpu = gpu();
+    let (gather, _) = indirect_of(&gpu, &settings(Method::MultiresGather));
+    let (splat, stats) = indirect_of(&gpu, &settings(Method::MultiresSplat));
+    assert_same("multires-splat vs multires-gather", &splat, &gather, 1e-5);
+    assert!(stats.iter().any(|p| p.name == "splat"));
+}
