@@ -145,6 +145,40 @@ enum DebugView {
     VplCount,
 }
 
+/// A one-line progress bar (redrawn in place): frames, and the submissions of
+/// the current frame when there are several (the reference's chunks), with
+/// the time left estimated from the time so far.
+fn progress_line(p: &crate::renderer::FrameProgress, elapsed: f64) -> String {
+    let total = (p.frames * p.submissions) as f64;
+    let done = ((p.frame.min(p.frames - 1) * p.submissions) + p.submission) as f64;
+    let done = if p.frame == p.frames && p.submission == p.submissions {
+        total
+    } else {
+        done
+    };
+    let fraction = (done / total).clamp(0.0, 1.0);
+    let width = 30;
+    let filled = (fraction * width as f64).round() as usize;
+    let left = if fraction > 0.0 {
+        elapsed / fraction - elapsed
+    } else {
+        0.0
+    };
+    let part = if p.submissions > 1 {
+        format!(", part {}/{}", p.submission, p.submissions)
+    } else {
+        String::new()
+    };
+    format!(
+        "\r[{}{}] {:>3.0}% frame {}/{}{part}, {left:.0} s left ",
+        "#".repeat(filled),
+        "-".repeat(width - filled),
+        fraction * 100.0,
+        (p.frame + 1).min(p.frames),
+        p.frames
+    )
+}
+
 /// Parses `std::env::args` and runs the command.
 pub fn run() -> Result<()> {
     let cli = Cli::parse();
@@ -224,7 +258,7 @@ fn render(args: RenderArgs) -> Result<()> {
             normal_threshold_deg: args.light_normal_threshold,
             isr_base: args.isr_base,
             start_level: args.start_level,
-            max_depth: Some(args.max_depth.unwrap_or(6.min(args.rsm.max(1).ilog2()))),
+            max_depth: args.max_depth,
             tau: args.tau,
         },
         splat_threshold: args.splat_threshold,
@@ -242,10 +276,11 @@ fn render(args: RenderArgs) -> Result<()> {
     );
     let mut renderer = Renderer::new(&gpu, &scene, &settings)?;
     let frames = args.frames;
-    let stats = renderer.render_frames(frames, |i| {
-        if frames > 1 {
-            eprint!("\rframe {i}/{frames}");
-            if i == frames {
+    let started = std::time::Instant::now();
+    let stats = renderer.render_frames(frames, |p| {
+        if frames > 1 || p.submissions > 1 {
+            eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
+            if p.frame == p.frames && p.submission == p.submissions {
                 eprintln!();
             }
         }

@@ -3,6 +3,7 @@
 
 use crate::gpu_types::{self, bytes_of, slice_bytes, DrawPush, FrameUniforms, MaterialGpu};
 use crate::methods::gather::GatherMethod;
+use crate::methods::reference::ReferencePass;
 use crate::methods::rsm_gather::RsmGatherPass;
 use crate::methods::rsm_splat::RsmSplatPass;
 use crate::methods::FullResolution;
@@ -43,6 +44,8 @@ pub enum Method {
     RsmSplatRestricted,
     /// Each VPL splats into every patch of the multiresolution buffer.
     MultiresSplat,
+    /// Every pixel gathers every RSM texel (R^2 VPLs), in chunks.
+    Reference,
 }
 
 impl Method {
@@ -56,6 +59,7 @@ impl Method {
             Method::RsmSplat => "rsm-splat",
             Method::RsmSplatRestricted => "rsm-splat-restricted",
             Method::MultiresSplat => "multires-splat",
+            Method::Reference => "reference",
         }
     }
 
@@ -80,8 +84,8 @@ pub struct LightTreeSettings {
     pub isr_base: u32,
     /// HISR starts from 2^s x 2^s patches.
     pub start_level: u32,
-    /// HISR subdivides down to 2^d x 2^d patches (`None`: the RSM itself,
-    /// log2 R). Invalid patches are always subdivided down to this depth, so
+    /// HISR subdivides down to 2^d x 2^d patches (`None`: 6, or log2 R if
+    /// smaller). Invalid patches are always subdivided down to this depth, so
     /// it bounds the cost of discontinuities in light space.
     pub max_depth: Option<u32>,
     /// HISR's error threshold tau, as a fraction of the light's peak intensity.
@@ -95,7 +99,7 @@ impl Default for LightTreeSettings {
             normal_threshold_deg: 30.0,
             isr_base: 64,
             start_level: 2,
-            max_depth: Some(6),
+            max_depth: None,
             tau: 0.05,
         }
     }
@@ -134,6 +138,9 @@ pub struct RenderSettings {
     pub light_tree: LightTreeSettings,
     /// Restricted splats skip where a VPL's irradiance bound is below this (W/m^2).
     pub splat_threshold: f32,
+    /// The reference's light-patch evaluations per submission: about 0.5 s on
+    /// lavapipe at the default, milliseconds on a GPU.
+    pub reference_chunk: u64,
 }
 
 impl Default for RenderSettings {
@@ -153,6 +160,7 @@ impl Default for RenderSettings {
             multires: MultiresSettings::default(),
             light_tree: LightTreeSettings::default(),
             splat_threshold: 0.01,
+            reference_chunk: 1 << 26,
         }
     }
 }
@@ -614,8 +622,22 @@ pub struct Renderer<'g> {
     pub gather_method: Option<GatherMethod>,
     /// The pass of a full-resolution method.
     full_resolution: Option<FullResolution>,
+    reference: Option<ReferencePass>,
     profiler: Profiler,
-    frame_cmd: vk::CommandBuffer,
+    /// One frame: submitted in order, each waited for (one, except for the
+    /// reference's chunks).
+    frame_cmds: Vec<vk::CommandBuffer>,
+}
+
+/// Where `render_frames` is, for progress reports.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameProgress {
+    /// Frames finished (1-based once a frame is done).
+    pub frame: u32,
+    pub frames: u32,
+    /// Submissions of the current frame finished, of `submissions`.
+    pub submission: u32,
+    pub submissions: u32,
 }
 
 /// Passes a frame can hold; the profiler's query pools are this large.
@@ -687,7 +709,7 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     if !(s.splat_threshold.is_finite() && s.splat_threshold >= 0.0) {
         bail!("--splat-threshold must be a finite non-negative irradiance (W/m^2)");
     }
-    if s.method != Method::None {
+    if s.method != Method::None && s.method != Method::Reference {
         let side = (s.vpls as f64).sqrt() as u32;
         if s.vpls == 0 || side * side != s.vpls || !side.is_power_of_two() {
             bail!("--vpls {}: the number of regular VPLs must be a power of 4 (1, 4, 16, ..., 4096, ...)", s.vpls);
@@ -719,8 +741,8 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
             );
         }
         let top = r.ilog2();
-        let max_depth = lt.max_depth.unwrap_or(top);
-        if max_depth > top || lt.start_level > max_depth {
+        let max_depth = hisr_max_depth(s);
+        if s.method == Method::Hisr && (max_depth > top || lt.start_level > max_depth) {
             bail!(
                 "--start-level {} and --max-depth {max_depth} must satisfy start <= max <= log2(--rsm) = {top}",
                 lt.start_level
@@ -755,6 +777,21 @@ fn multires_bytes(s: &RenderSettings) -> u64 {
     let pixels = s.width as u64 * s.height as u64;
     let layers = levels_of(s).min(crate::multires::MAX_LEVELS) as u64 + 1;
     layers * pixels * (16 + 4 + 4) + pixels * 4 / 3 * (4 * 16 + 4)
+}
+
+/// HISR's deepest level: `--max-depth`, by default 6 or log2 R if smaller.
+pub fn hisr_max_depth(s: &RenderSettings) -> u32 {
+    s.light_tree
+        .max_depth
+        .unwrap_or(6.min(s.rsm_resolution.max(1).ilog2()))
+}
+
+/// The regular VPLs a method uses: every RSM texel for `reference`.
+pub fn effective_vpls(s: &RenderSettings) -> u32 {
+    match s.method {
+        Method::Reference => s.rsm_resolution * s.rsm_resolution,
+        _ => s.vpls,
+    }
 }
 
 /// The RSM quadtree level (mip) Basic ISR starts from.
@@ -796,7 +833,7 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
     let light_view_proj = projection(2.0 * half_fov, 1.0, light_near) * light_view;
     let (scale, offset) = l.cone_scale_offset();
     let r = s.rsm_resolution as f32;
-    let side = ((s.vpls as f64).sqrt() as u32).max(1);
+    let side = ((effective_vpls(s) as f64).sqrt() as u32).max(1);
     let vpl_level = s.rsm_resolution.max(side).ilog2() - side.ilog2();
     let mut flags = 0;
     if s.vpl_sampling == VplSampling::Point {
@@ -839,7 +876,7 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
         splat: [s.splat_threshold, 0.0, 0.0, 0.0],
         light_levels: [
             lt.start_level as i32,
-            lt.max_depth.unwrap_or(top) as i32,
+            hisr_max_depth(s) as i32,
             isr_base_mip(s) as i32,
             top as i32,
         ],
@@ -893,8 +930,19 @@ impl<'g> Renderer<'g> {
             }
             _ => None,
         };
-        let profiler = Profiler::new(gpu, MAX_PASSES)?;
-        let frame_cmd = gpu.allocate_command_buffer()?;
+        let reference = match settings.method {
+            Method::Reference => Some(ReferencePass::new(
+                gpu,
+                &inputs,
+                settings.width,
+                settings.height,
+                settings.rsm_resolution,
+                settings.reference_chunk.max(1),
+            )?),
+            _ => None,
+        };
+        let chunks = reference.as_ref().map_or(0, |r| r.chunks.len() as u32);
+        let profiler = Profiler::new(gpu, MAX_PASSES + chunks)?;
         let mut r = Self {
             gpu,
             settings: settings.clone(),
@@ -911,8 +959,9 @@ impl<'g> Renderer<'g> {
             rsm_tree,
             gather_method,
             full_resolution,
+            reference,
             profiler,
-            frame_cmd,
+            frame_cmds: Vec::new(),
         };
         if settings.method == Method::None {
             r.clear_indirect()?;
@@ -951,12 +1000,18 @@ impl<'g> Renderer<'g> {
     /// Records the frame once; every `render_frames` submission replays it.
     fn record_frame(&mut self) -> Result<()> {
         let gpu = self.gpu;
-        let cmd = self.frame_cmd;
-        unsafe {
-            gpu.device
-                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?
+        let begin = |cmds: &mut Vec<vk::CommandBuffer>| -> Result<vk::CommandBuffer> {
+            let cmd = gpu.allocate_command_buffer()?;
+            unsafe {
+                gpu.device
+                    .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?
+            };
+            cmds.push(cmd);
+            Ok(cmd)
         };
-        let ctx = FrameContext {
+        let mut cmds = Vec::new();
+        let mut cmd = begin(&mut cmds)?;
+        let ctx = |cmd| FrameContext {
             gpu,
             cmd,
             scene: &self.scene,
@@ -964,38 +1019,61 @@ impl<'g> Renderer<'g> {
         };
         let p = &mut self.profiler;
         p.begin_frame(gpu, cmd);
-        self.rsm.record(&ctx, p);
-        self.gbuffer.record(&ctx, p);
-        self.direct.record(&ctx, p);
+        self.rsm.record(&ctx(cmd), p);
+        self.gbuffer.record(&ctx(cmd), p);
+        self.direct.record(&ctx(cmd), p);
         if let Some(t) = &self.rsm_tree {
-            t.record(&ctx, p);
+            t.record(&ctx(cmd), p);
         }
         // Method `none`: indirect stays zero (cleared once in `new`).
         if let Some(m) = &self.gather_method {
-            m.record(&ctx, p);
+            m.record(&ctx(cmd), p);
         }
         if let Some(m) = &self.full_resolution {
-            m.record(&ctx, p);
+            m.record(&ctx(cmd), p);
         }
-        self.composite.record(&ctx, p);
-        self.tonemap.record(&ctx, p);
+        if let Some(r) = &self.reference {
+            for i in 0..r.chunks.len() {
+                if i > 0 {
+                    unsafe { gpu.device.end_command_buffer(cmd)? };
+                    cmd = begin(&mut cmds)?;
+                }
+                r.record_chunk(&ctx(cmd), p, i);
+            }
+        }
+        self.composite.record(&ctx(cmd), p);
+        self.tonemap.record(&ctx(cmd), p);
         unsafe { gpu.device.end_command_buffer(cmd)? };
+        self.frame_cmds = cmds;
         Ok(())
     }
 
-    /// Renders `n` frames, each submitted and waited for, and returns every
-    /// frame's per-pass numbers. `progress` is called after each frame.
-    pub fn render_frames(&mut self, n: u32, mut progress: impl FnMut(u32)) -> Result<FrameStats> {
+    /// Renders `n` frames, each submission waited for, and returns every
+    /// frame's per-pass numbers. `progress` is called after each submission.
+    pub fn render_frames(
+        &mut self,
+        n: u32,
+        mut progress: impl FnMut(FrameProgress),
+    ) -> Result<FrameStats> {
         let mut stats = FrameStats::default();
+        let submissions = self.frame_cmds.len() as u32;
         for i in 0..n {
             let start = Instant::now();
-            self.gpu.submit_and_wait(self.frame_cmd)?;
+            for (k, cmd) in self.frame_cmds.iter().enumerate() {
+                self.gpu.submit_and_wait(*cmd)?;
+                let done = k as u32 + 1;
+                progress(FrameProgress {
+                    frame: i + (done == submissions) as u32,
+                    frames: n,
+                    submission: done,
+                    submissions,
+                });
+            }
             stats.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
             stats.frames.push(self.profiler.read(self.gpu)?);
             if let Some(m) = &self.gather_method {
                 stats.patches_per_level = Some(m.multires.buffer.patch_counts());
             }
-            progress(i + 1);
         }
         Ok(stats)
     }
@@ -1309,8 +1387,10 @@ impl Drop for Renderer<'_> {
         let gpu = self.gpu;
         unsafe {
             let _ = gpu.device.device_wait_idle();
-            gpu.device
-                .free_command_buffers(gpu.command_pool, &[self.frame_cmd]);
+            if !self.frame_cmds.is_empty() {
+                gpu.device
+                    .free_command_buffers(gpu.command_pool, &self.frame_cmds);
+            }
         }
         self.rsm.destroy(gpu);
         self.gbuffer.destroy(gpu);
@@ -1325,6 +1405,9 @@ impl Drop for Renderer<'_> {
         }
         if let Some(m) = &mut self.full_resolution {
             m.destroy(gpu);
+        }
+        if let Some(r) = &mut self.reference {
+            r.destroy(gpu);
         }
         self.profiler.destroy(gpu);
         for i in self.targets.all_mut() {

@@ -123,3 +123,40 @@ fn multires_splat_equals_multires_gather() {
     assert_same("multires-splat vs multires-gather", &splat, &gather, 1e-5);
     assert!(stats.iter().any(|p| p.name == "splat"));
 }
+
+#[test]
+fn reference_in_chunks_equals_rsm_gather_with_every_texel() {
+    let gpu = gpu();
+    let rsm = 32;
+    let gather = RenderSettings {
+        rsm_resolution: rsm,
+        vpls: rsm * rsm,
+        ..settings(Method::RsmGather)
+    };
+    let reference = RenderSettings {
+        rsm_resolution: rsm,
+        // 96 x 80 pixels x 100 VPLs per submission: 11 chunks for 1024 VPLs.
+        reference_chunk: 96 * 80 * 100,
+        ..settings(Method::Reference)
+    };
+    let mut r = Renderer::new(&gpu, &cornell_box(), &reference).unwrap();
+    let mut submissions = 0;
+    let stats = r.render_frames(1, |p| submissions = p.submissions).unwrap();
+    let chunked = r.readback().unwrap().indirect;
+    drop(r);
+    assert_validation_clean(&gpu);
+    assert_eq!(submissions, 11, "one submission per chunk");
+    let names: Vec<&str> = stats.frames[0].iter().map(|p| p.name).collect();
+    assert_eq!(
+        names.iter().filter(|n| **n == "reference").count(),
+        1,
+        "chunks are reported as one pass: {names:?}"
+    );
+    let (dense, _) = indirect_of(&gpu, &gather);
+    assert_same(
+        "reference vs rsm-gather with R^2 VPLs",
+        &chunked,
+        &dense,
+        1e-5,
+    );
+}

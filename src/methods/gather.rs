@@ -107,6 +107,7 @@ impl GatherPass {
                     extent: m.illumination.extent,
                     layers: m.illumination.layers,
                     colors: &colors,
+                    clear_colors: true,
                     depth: None,
                     stencil: self.stencil.then_some(StencilAttachment {
                         view: m.stencil.view,

@@ -7,6 +7,7 @@ pub mod gather;
 pub mod hisr;
 pub mod isr;
 pub mod multires_splat;
+pub mod reference;
 pub mod rsm_gather;
 pub mod rsm_splat;
 

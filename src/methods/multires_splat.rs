@@ -84,6 +84,7 @@ impl MultiresSplatPass {
                     extent: m.illumination.extent,
                     layers: m.illumination.layers,
                     colors: &colors,
+                    clear_colors: true,
                     depth: None,
                     stencil: Some(StencilAttachment {
                         view: m.stencil.view,

@@ -88,6 +88,7 @@ impl StencilRefinePass {
                     extent: m.stencil.extent,
                     layers: m.stencil.layers,
                     colors: &[],
+                    clear_colors: true,
                     depth: None,
                     stencil: Some(StencilAttachment {
                         view: m.stencil.view,

@@ -40,6 +40,8 @@ pub struct Attachments<'a> {
     /// Layers of layered rendering (`gl_Layer`); 1 otherwise.
     pub layers: u32,
     pub colors: &'a [vk::ImageView],
+    /// Clear the colors to zero (or keep what they hold).
+    pub clear_colors: bool,
     pub depth: Option<vk::ImageView>,
     pub stencil: Option<StencilAttachment>,
 }
@@ -62,6 +64,7 @@ impl<'a> Attachments<'a> {
             extent,
             layers: 1,
             colors,
+            clear_colors: true,
             depth,
             stencil: None,
         }
@@ -78,7 +81,11 @@ pub fn begin_rendering(gpu: &Gpu, cmd: vk::CommandBuffer, a: &Attachments) {
             vk::RenderingAttachmentInfo::default()
                 .image_view(*view)
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .load_op(if a.clear_colors {
+                    vk::AttachmentLoadOp::CLEAR
+                } else {
+                    vk::AttachmentLoadOp::LOAD
+                })
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue {
                     color: vk::ClearColorValue { float32: [0.0; 4] },

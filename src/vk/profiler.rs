@@ -228,24 +228,35 @@ impl Profiler {
                 };
             }
         }
-        Ok(self
-            .passes
-            .iter()
-            .enumerate()
-            .map(|(i, &(name, kind))| {
-                let ticks = times[i + 1].wrapping_sub(times[i]) & self.timestamp_mask;
-                PassSample {
-                    name,
-                    kind,
-                    gpu_ms: self
-                        .timestamps
-                        .map(|_| ticks as f64 * self.ns_per_tick * 1e-6),
-                    fragment_invocations: self.statistics.map(|_| stats[i][0]),
-                    compute_invocations: self.statistics.map(|_| stats[i][1]),
-                    samples_passed: kind.graphics.then_some(samples[i]),
+        let samples = self.passes.iter().enumerate().map(|(i, &(name, kind))| {
+            let ticks = times[i + 1].wrapping_sub(times[i]) & self.timestamp_mask;
+            PassSample {
+                name,
+                kind,
+                gpu_ms: self
+                    .timestamps
+                    .map(|_| ticks as f64 * self.ns_per_tick * 1e-6),
+                fragment_invocations: self.statistics.map(|_| stats[i][0]),
+                compute_invocations: self.statistics.map(|_| stats[i][1]),
+                samples_passed: kind.graphics.then_some(samples[i]),
+            }
+        });
+        // A pass recorded several times in a row (the reference's chunks, one
+        // per submission) is reported once, its numbers summed.
+        let mut merged: Vec<PassSample> = Vec::new();
+        for s in samples {
+            match merged.last_mut() {
+                Some(m) if m.name == s.name => {
+                    let add = |a: Option<u64>, b: Option<u64>| a.zip(b).map(|(a, b)| a + b);
+                    m.gpu_ms = m.gpu_ms.zip(s.gpu_ms).map(|(a, b)| a + b);
+                    m.fragment_invocations = add(m.fragment_invocations, s.fragment_invocations);
+                    m.compute_invocations = add(m.compute_invocations, s.compute_invocations);
+                    m.samples_passed = add(m.samples_passed, s.samples_passed);
                 }
-            })
-            .collect())
+                _ => merged.push(s),
+            }
+        }
+        Ok(merged)
     }
 
     pub fn destroy(&mut self, gpu: &Gpu) {
