@@ -23,7 +23,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene headless and write EXR, PNG and per-pass GPU timings.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// List the Vulkan devices (the index is what --device takes).
     Devices,
     /// Write the built-in Cornell box as a glTF file.
@@ -121,6 +121,12 @@ struct RenderArgs {
     /// ... and their normals by less than this angle (degrees).
     #[arg(long, default_value_t = 30.0)]
     light_normal_threshold: f32,
+    /// Indirect samples per pixel for --method pathtrace.
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    /// Random seed for --method pathtrace.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
     /// Restricted splats: a VPL's quad covers only where its irradiance bound
     /// Phi / (pi d^2) exceeds this (W/m^2); 0 gives full-screen splats.
     #[arg(long, default_value_t = 0.01)]
@@ -143,6 +149,73 @@ enum DebugView {
     Levels,
     Indirect,
     VplCount,
+}
+
+/// `--method pathtrace`: the CPU reference, with a progress bar.
+fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
+    if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
+        bail!(
+            "resolution {}x{}: width and height must be within 1..=16384",
+            args.width,
+            args.height
+        );
+    }
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    let threads = rayon::current_num_threads();
+    eprintln!(
+        "path tracing {} ({} triangles) at {}x{}, {} spp, on {threads} CPU threads",
+        scene.name,
+        scene.triangle_count(),
+        args.width,
+        args.height,
+        args.spp
+    );
+    let started = std::time::Instant::now();
+    let result = crate::pathtrace::render(
+        scene,
+        &crate::pathtrace::PathTraceSettings {
+            width: args.width,
+            height: args.height,
+            spp: args.spp,
+            seed: args.seed,
+            exposure: args.exposure,
+        },
+        |done, rows| {
+            let fraction = done as f64 / rows as f64;
+            let elapsed = started.elapsed().as_secs_f64();
+            let left = if fraction > 0.0 {
+                elapsed / fraction - elapsed
+            } else {
+                0.0
+            };
+            let filled = (fraction * 30.0).round() as usize;
+            eprint!(
+                "\r[{}{}] {:>3.0}% rows {done}/{rows}, {left:.0} s left ",
+                "#".repeat(filled),
+                "-".repeat(30 - filled),
+                fraction * 100.0
+            );
+        },
+    );
+    eprintln!();
+    let ms = started.elapsed().as_secs_f64() * 1e3;
+    println!("pathtrace: {ms:.1} ms on {threads} CPU threads");
+    if let Some(path) = &args.timings {
+        let report = serde_json::json!({
+            "device": format!("CPU ({threads} threads)"), "driver": "isr::pathtrace", "scene": scene.name,
+            "width": args.width, "height": args.height, "method": "pathtrace", "frames": 1, "spp": args.spp,
+            "passes": [], "total_gpu_ms_median": null, "indirect_gpu_ms_median": null, "wall_ms_median": ms,
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    output::write_exr(&args.out, &result)?;
+    output::write_png(&args.png, result.width, result.height, &result.display)?;
+    println!("wrote {} and {}", args.out.display(), args.png.display());
+    Ok(())
 }
 
 /// A one-line progress bar (redrawn in place): frames, and the submissions of
@@ -183,7 +256,7 @@ fn progress_line(p: &crate::renderer::FrameProgress, elapsed: f64) -> String {
 pub fn run() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Render(args) => render(args),
+        Command::Render(args) => render(*args),
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {
             let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;
@@ -226,6 +299,9 @@ fn render(args: RenderArgs) -> Result<()> {
     };
     for w in &scene.warnings {
         eprintln!("warning: {w}");
+    }
+    if args.method == Method::Pathtrace {
+        return pathtrace(&args, &scene);
     }
     if scene.light.outer_cone > crate::renderer::MAX_RSM_HALF_FOV {
         eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");

@@ -44,7 +44,8 @@ pub fn levels_png(m: &MultiresReadback) -> Vec<u8> {
         .collect()
 }
 
-fn srgb(c: f32) -> u8 {
+/// Linear value to an 8-bit sRGB code, clamped.
+pub fn srgb(c: f32) -> u8 {
     let c = c.clamp(0.0, 1.0);
     let e = if c <= 0.0031308 {
         12.92 * c

@@ -12,6 +12,7 @@ pub mod methods;
 pub mod multires;
 pub mod output;
 pub mod passes;
+pub mod pathtrace;
 pub mod renderer;
 pub mod report;
 pub mod scene;

@@ -46,6 +46,8 @@ pub enum Method {
     MultiresSplat,
     /// Every pixel gathers every RSM texel (R^2 VPLs), in chunks.
     Reference,
+    /// One-bounce path tracing with indirect visibility, on the CPU.
+    Pathtrace,
 }
 
 impl Method {
@@ -60,6 +62,7 @@ impl Method {
             Method::RsmSplatRestricted => "rsm-splat-restricted",
             Method::MultiresSplat => "multires-splat",
             Method::Reference => "reference",
+            Method::Pathtrace => "pathtrace",
         }
     }
 
@@ -709,7 +712,10 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     if !(s.splat_threshold.is_finite() && s.splat_threshold >= 0.0) {
         bail!("--splat-threshold must be a finite non-negative irradiance (W/m^2)");
     }
-    if s.method != Method::None && s.method != Method::Reference {
+    if !matches!(
+        s.method,
+        Method::None | Method::Reference | Method::Pathtrace
+    ) {
         let side = (s.vpls as f64).sqrt() as u32;
         if s.vpls == 0 || side * side != s.vpls || !side.is_power_of_two() {
             bail!("--vpls {}: the number of regular VPLs must be a power of 4 (1, 4, 16, ..., 4096, ...)", s.vpls);
@@ -885,6 +891,9 @@ pub fn frame_uniforms(scene: &Scene, s: &RenderSettings) -> FrameUniforms {
 
 impl<'g> Renderer<'g> {
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
+        if settings.method == Method::Pathtrace {
+            bail!("method pathtrace runs on the CPU (isr::pathtrace::render), not in the Vulkan renderer");
+        }
         check_settings(gpu, settings)?;
         let frame_uniforms = frame_uniforms(scene, settings);
         let mut uniforms = Buffer::new(

@@ -1,0 +1,314 @@
+//! Method `pathtrace` (ALGORITHM.md sections 1 and 5): a one-bounce diffuse
+//! reference WITH indirect visibility, on the CPU (all cores, rayon), from the
+//! same spot light, camera and materials as the rasterizer. It shows the error
+//! that ignoring indirect visibility causes, which every VPL method shares.
+//!
+//! Per pixel, the primary ray goes through the pixel centre (as the G-buffer
+//! samples it), so the direct layer is noise-free:
+//!   L_direct(x) = rho/pi * I(w) * max(0, n.l) / r^2 * V     (shadow ray, exact V)
+//! Indirect irradiance by cosine-weighted hemisphere sampling, `spp` rays:
+//!   E(x) = integral of L_direct(y(w)) cos dw ~= pi / N * sum_k L_direct(y_k)
+//! where y_k is the nearest surface along sample k (occlusion included). The
+//! layers mean what the rasterizer's mean (section 2): `indirect` is E.
+
+pub mod bvh;
+
+use crate::renderer::{frame_uniforms, Readback, RenderSettings, RsmReadback};
+use crate::scene::{Scene, SpotLight};
+use bvh::{Bvh, Triangle};
+use glam::{Mat4, Vec2, Vec3, Vec3A, Vec4};
+use rayon::prelude::*;
+use std::f32::consts::PI;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Materials as the path tracer shades them: albedo factor and optional texture.
+struct Shading<'a> {
+    scene: &'a Scene,
+    bvh: Bvh,
+    light: SpotLight,
+    /// Ray offset off surfaces, relative to the scene size.
+    epsilon: f32,
+}
+
+/// A small, fast generator (PCG32) seeded per pixel, so results do not depend
+/// on the thread schedule.
+struct Pcg(u64);
+
+impl Pcg {
+    fn new(seed: u64, stream: u64) -> Self {
+        let mut p = Pcg(seed.wrapping_add(stream.wrapping_mul(0x9E37_79B9_7F4A_7C15)));
+        p.next();
+        p.next();
+        p
+    }
+
+    fn next(&mut self) -> u32 {
+        let old = self.0;
+        self.0 = old
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        xorshifted.rotate_right((old >> 59) as u32)
+    }
+
+    /// Uniform in [0, 1).
+    fn uniform(&mut self) -> f32 {
+        (self.next() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+}
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A surface point found by a ray.
+struct SurfacePoint {
+    position: Vec3A,
+    /// Shading normal, turned to the side the ray came from for back faces of
+    /// double-sided materials (as the rasterizer's `facing_normal`).
+    normal: Vec3A,
+    albedo: Vec3,
+}
+
+impl Shading<'_> {
+    fn new(scene: &Scene) -> Shading<'_> {
+        let mut triangles = Vec::new();
+        for inst in &scene.instances {
+            let mesh = &scene.meshes[inst.mesh];
+            let m = inst.world_from_object;
+            let normal_matrix = Mat4::from_mat3(glam::Mat3::from_mat4(m).inverse().transpose());
+            let double_sided = scene.materials[mesh.material].double_sided;
+            for t in mesh.indices.chunks_exact(3) {
+                let v = |k: usize| &mesh.vertices[t[k] as usize];
+                triangles.push(Triangle {
+                    p: std::array::from_fn(|k| {
+                        Vec3A::from(m.transform_point3(Vec3::from(v(k).position)))
+                    }),
+                    n: std::array::from_fn(|k| {
+                        Vec3A::from(normal_matrix.transform_vector3(Vec3::from(v(k).normal)))
+                            .normalize_or_zero()
+                    }),
+                    uv: std::array::from_fn(|k| v(k).uv),
+                    material: mesh.material as u32,
+                    double_sided,
+                });
+            }
+        }
+        let size = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
+        Shading {
+            scene,
+            bvh: Bvh::new(triangles),
+            light: scene.light,
+            epsilon: size * 1e-5,
+        }
+    }
+
+    fn texture(&self, index: usize, uv: Vec2) -> Vec3 {
+        let t = &self.scene.textures[index];
+        // Bilinear with repeat, on linear values, as the GPU sampler does.
+        let (w, h) = (t.width as f32, t.height as f32);
+        let x = uv.x * w - 0.5;
+        let y = uv.y * h - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |xi: f32, yi: f32| {
+            let xi = (xi as i64).rem_euclid(t.width as i64) as usize;
+            let yi = (yi as i64).rem_euclid(t.height as i64) as usize;
+            let o = 4 * (yi * t.width as usize + xi);
+            Vec3::new(
+                srgb_to_linear(t.rgba8[o]),
+                srgb_to_linear(t.rgba8[o + 1]),
+                srgb_to_linear(t.rgba8[o + 2]),
+            )
+        };
+        let top = texel(x0, y0).lerp(texel(x0 + 1.0, y0), fx);
+        let bottom = texel(x0, y0 + 1.0).lerp(texel(x0 + 1.0, y0 + 1.0), fx);
+        top.lerp(bottom, fy)
+    }
+
+    fn trace(&self, origin: Vec3A, dir: Vec3A) -> Option<SurfacePoint> {
+        let hit = self
+            .bvh
+            .intersect(origin, dir, self.epsilon, f32::INFINITY, false)?;
+        let tri = &self.bvh.triangles[hit.triangle as usize];
+        let w = 1.0 - hit.u - hit.v;
+        let mut normal = (tri.n[0] * w + tri.n[1] * hit.u + tri.n[2] * hit.v).normalize_or_zero();
+        let geometric = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]);
+        if geometric.dot(dir) > 0.0 {
+            normal = -normal; // a back face (double-sided materials only reach here)
+        }
+        let material = &self.scene.materials[tri.material as usize];
+        let uv = Vec2::from(tri.uv[0]) * w
+            + Vec2::from(tri.uv[1]) * hit.u
+            + Vec2::from(tri.uv[2]) * hit.v;
+        let mut albedo = material.base_color.truncate();
+        if let Some(t) = material.texture {
+            albedo *= self.texture(t, uv);
+        }
+        Some(SurfacePoint {
+            position: origin + dir * hit.t,
+            normal,
+            albedo,
+        })
+    }
+
+    /// Radiance leaving `s` (Lambertian) from the spot light, shadow ray included.
+    fn direct(&self, s: &SurfacePoint) -> Vec3 {
+        let to_light = Vec3A::from(self.light.position) - s.position;
+        let r2 = to_light.length_squared();
+        let r = r2.sqrt();
+        let l = to_light / r;
+        let cos = s.normal.dot(l);
+        if cos <= 0.0 || r2 == 0.0 {
+            return Vec3::ZERO;
+        }
+        let intensity = self
+            .light
+            .intensity_toward(Vec3::from(s.position).as_dvec3())
+            .as_vec3();
+        if intensity.max_element() <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let origin = s.position + s.normal * self.epsilon;
+        if self
+            .bvh
+            .intersect(origin, l, self.epsilon, r * (1.0 - 1e-4), true)
+            .is_some()
+        {
+            return Vec3::ZERO;
+        }
+        s.albedo / PI * intensity * cos / r2
+    }
+
+    /// Indirect irradiance at `s` from `spp` cosine-weighted one-bounce rays.
+    fn indirect(&self, s: &SurfacePoint, spp: u32, rng: &mut Pcg) -> Vec3 {
+        let n = s.normal;
+        // An orthonormal basis around n (Duff et al. 2017).
+        let sign = 1f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let t = Vec3A::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let bt = Vec3A::new(b, sign + n.y * n.y * a, -n.y);
+        let origin = s.position + n * self.epsilon;
+        let mut sum = Vec3::ZERO;
+        for _ in 0..spp {
+            let (u1, u2) = (rng.uniform(), rng.uniform());
+            let r = u1.sqrt();
+            let phi = 2.0 * PI * u2;
+            let dir = (t * (r * phi.cos()) + bt * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
+                .normalize();
+            if let Some(y) = self.trace(origin, dir) {
+                sum += self.direct(&y);
+            }
+        }
+        sum * (PI / spp as f32)
+    }
+}
+
+/// What `render` needs besides the scene.
+#[derive(Clone, Debug)]
+pub struct PathTraceSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Indirect samples per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    pub exposure: f32,
+}
+
+/// Renders `scene`; `progress(rows_done, rows)` is called from a helper thread
+/// about four times a second. The RSM part of the result is empty.
+pub fn render(
+    scene: &Scene,
+    s: &PathTraceSettings,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Readback {
+    let shading = Shading::new(scene);
+    let uniforms = frame_uniforms(
+        scene,
+        &RenderSettings {
+            width: s.width,
+            height: s.height,
+            ..Default::default()
+        },
+    );
+    let clip_to_world = Mat4::from_cols_array_2d(&uniforms.camera_view_proj).inverse();
+    let eye = Vec3A::from(scene.camera.position());
+    let forward = Vec3A::from(scene.camera.forward());
+    let (w, h) = (s.width as usize, s.height as usize);
+    let mut pixels = vec![[[0f32; 4]; 6]; w * h]; // final, direct, indirect, albedo, normal, position
+    let rows_done = AtomicUsize::new(0);
+    std::thread::scope(|scope| {
+        let done = &rows_done;
+        let reporter = scope.spawn(|| loop {
+            let d = done.load(Ordering::Relaxed);
+            progress(d, h);
+            if d >= h {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(250));
+        });
+        pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, out) in row.iter_mut().enumerate() {
+                // Through the pixel centre, as the rasterizer samples it.
+                let ndc = Vec4::new(
+                    2.0 * (x as f32 + 0.5) / s.width as f32 - 1.0,
+                    2.0 * (y as f32 + 0.5) / s.height as f32 - 1.0,
+                    1.0, // the near plane in reversed-Z
+                    1.0,
+                );
+                let p = clip_to_world * ndc;
+                let dir = (Vec3A::from(p.truncate() / p.w) - eye).normalize();
+                let Some(hit) = shading.trace(eye, dir) else {
+                    continue;
+                };
+                let mut rng = Pcg::new(s.seed, (y * w + x) as u64);
+                let direct = shading.direct(&hit);
+                let indirect = shading.indirect(&hit, s.spp, &mut rng);
+                let final_radiance = direct + hit.albedo / PI * indirect;
+                let depth = (hit.position - eye).dot(forward).max(1e-6);
+                *out = [
+                    final_radiance.extend(1.0).to_array(),
+                    direct.extend(1.0).to_array(),
+                    indirect.extend(1.0).to_array(),
+                    hit.albedo.extend(1.0).to_array(),
+                    Vec3::from(hit.normal).extend(0.0).to_array(),
+                    Vec3::from(hit.position).extend(depth).to_array(),
+                ];
+            }
+            done.fetch_add(1, Ordering::Relaxed);
+        });
+        let _ = reporter.join();
+    });
+    let layer = |k: usize| pixels.iter().map(|p| p[k]).collect::<Vec<_>>();
+    let final_radiance = layer(0);
+    let display = final_radiance
+        .iter()
+        .flat_map(|c| {
+            let e = |v: f32| crate::debug_view::srgb(v * s.exposure);
+            [e(c[0]), e(c[1]), e(c[2]), 255]
+        })
+        .collect();
+    Readback {
+        width: s.width,
+        height: s.height,
+        final_radiance,
+        direct: layer(1),
+        indirect: layer(2),
+        albedo: layer(3),
+        normal: layer(4),
+        position: layer(5),
+        display,
+        rsm: RsmReadback {
+            resolution: 0,
+            position: vec![],
+            normal: vec![],
+            flux: vec![],
+        },
+    }
+}
