@@ -38,23 +38,42 @@ fn main() -> anyhow::Result<()> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench/comparison");
     std::fs::create_dir_all(&dir)?;
     let run = |method: Method, frames: u32| -> anyhow::Result<(Readback, f64)> {
-        let s = RenderSettings { method, ..base.clone() };
+        let s = RenderSettings {
+            method,
+            ..base.clone()
+        };
         let mut r = Renderer::new(&gpu, &scene, &s)?;
         let stats = r.render_frames(frames, |_| {})?;
         let totals: Vec<f64> = stats
             .frames
             .iter()
-            .map(|f| f.iter().filter(|p| p.kind.indirect).filter_map(|p| p.gpu_ms).sum())
+            .map(|f| {
+                f.iter()
+                    .filter(|p| p.kind.indirect)
+                    .filter_map(|p| p.gpu_ms)
+                    .sum()
+            })
             .collect();
         let out = r.readback()?;
-        isr::output::write_png(&dir.join(format!("{}.png", method.name())), out.width, out.height, &out.display)?;
+        isr::output::write_png(
+            &dir.join(format!("{}.png", method.name())),
+            out.width,
+            out.height,
+            &out.display,
+        )?;
         eprintln!("{}: done", method.name());
         Ok((out, isr::report::median(&totals).unwrap_or(f64::NAN)))
     };
     let (reference, reference_ms) = run(Method::Reference, 1)?;
     let traced = isr::pathtrace::render(
         &scene,
-        &isr::pathtrace::PathTraceSettings { width: 256, height: 256, spp: 256, seed: 1, exposure: 1.0 },
+        &isr::pathtrace::PathTraceSettings {
+            width: 256,
+            height: 256,
+            spp: 256,
+            seed: 1,
+            exposure: 1.0,
+        },
         |_, _| {},
     );
     isr::output::write_png(&dir.join("pathtrace.png"), 256, 256, &traced.display)?;
@@ -68,24 +87,34 @@ fn main() -> anyhow::Result<()> {
         Method::Hisr,
     ];
     let mut rows = Vec::new();
-    println!("{:<22} {:>12} {:>16} {:>14}", "method", "indirect ms", "indirect RMSE", "final RMSE");
+    println!(
+        "{:<22} {:>12} {:>16} {:>14}",
+        "method", "indirect ms", "indirect RMSE", "final RMSE"
+    );
     let geometry = &reference.position;
     for m in methods {
         let (out, ms) = run(m, 3)?;
         let ei = relative_rmse(&out.indirect, &reference.indirect, geometry);
         let ef = relative_rmse(&out.final_radiance, &reference.final_radiance, geometry);
         println!("{:<22} {:>12.1} {:>16.4} {:>14.4}", m.name(), ms, ei, ef);
-        rows.push(json!({"method": m.name(), "indirect_ms": ms, "indirect_rmse": ei, "final_rmse": ef}));
+        rows.push(
+            json!({"method": m.name(), "indirect_ms": ms, "indirect_rmse": ei, "final_rmse": ef}),
+        );
     }
     let ei = relative_rmse(&traced.indirect, &reference.indirect, geometry);
     let ef = relative_rmse(&traced.final_radiance, &reference.final_radiance, geometry);
-    println!("{:<22} {:>12} {:>16.4} {:>14.4}", "pathtrace (256 spp)", "cpu", ei, ef);
+    println!(
+        "{:<22} {:>12} {:>16.4} {:>14.4}",
+        "pathtrace (256 spp)", "cpu", ei, ef
+    );
     println!("reference: {reference_ms:.1} ms indirect");
     rows.push(json!({"method": "pathtrace", "indirect_rmse": ei, "final_rmse": ef}));
     std::fs::write(
         dir.join("../comparison.json"),
-        serde_json::to_string_pretty(&json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": 256,
-            "reference_ms": reference_ms, "runs": rows}))?,
+        serde_json::to_string_pretty(
+            &json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": 256,
+            "reference_ms": reference_ms, "runs": rows}),
+        )?,
     )?;
     Ok(())
 }

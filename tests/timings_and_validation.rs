@@ -169,12 +169,19 @@ fn validation_with_synchronization_checks_is_silent_over_several_frames() {
         (Method::MultiresGather, false),
         (Method::Isr, true),
         (Method::Hisr, true),
+        (Method::RsmGather, true),
+        (Method::RsmSplat, true),
+        (Method::RsmSplatRestricted, true),
+        (Method::MultiresSplat, true),
+        (Method::Reference, true),
     ] {
         let mut settings = RenderSettings {
             width: 160,
             height: 120,
             rsm_resolution: 128,
             method,
+            // Several submissions for the reference (4 chunks of 4,096 VPLs).
+            reference_chunk: 160 * 120 * 4096,
             ..Default::default()
         };
         settings.multires.stencil = stencil;
