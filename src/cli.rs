@@ -121,6 +121,11 @@ struct RenderArgs {
     /// ... and their normals by less than this angle (degrees).
     #[arg(long, default_value_t = 30.0)]
     light_normal_threshold: f32,
+    /// --method reference: light-patch evaluations per submission (pixels x
+    /// VPLs). The default keeps a submission near half a second on lavapipe;
+    /// on a GPU, larger chunks cut the per-submission overhead.
+    #[arg(long, default_value_t = 1 << 26)]
+    reference_chunk: u64,
     /// Indirect samples per pixel for --method pathtrace.
     #[arg(long, default_value_t = 64)]
     spp: u32,
@@ -338,6 +343,7 @@ fn render(args: RenderArgs) -> Result<()> {
             tau: args.tau,
         },
         splat_threshold: args.splat_threshold,
+        reference_chunk: args.reference_chunk,
         ..RenderSettings::default()
     };
     eprintln!(

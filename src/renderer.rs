@@ -709,6 +709,9 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     if !(s.exposure.is_finite() && s.exposure >= 0.0) {
         bail!("--exposure must be a finite non-negative number");
     }
+    if s.method == Method::MultiresSplat && !s.multires.stencil {
+        bail!("--stencil off measures the stenciled gathers; multires-splat always splats through the stencil");
+    }
     if !(s.splat_threshold.is_finite() && s.splat_threshold >= 0.0) {
         bail!("--splat-threshold must be a finite non-negative irradiance (W/m^2)");
     }

@@ -266,3 +266,24 @@ fn vpls_not_a_power_of_four() {
     );
     assert!(e.contains("power of 4"), "{e}");
 }
+
+#[test]
+fn multires_splat_refuses_stencil_off() {
+    let dir = temp_dir("splat-stencil");
+    let e = fails(
+        &dir,
+        &[
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--rsm",
+            "32",
+            "--method",
+            "multires-splat",
+            "--stencil",
+            "off",
+        ],
+    );
+    assert!(e.contains("--stencil off"), "{e}");
+}

@@ -213,7 +213,14 @@ fn path_tracer_differs_from_the_vpl_reference_where_the_bounce_is_occluded() {
             .filter(|q| {
                 let d = **q - x;
                 blocker
-                    .intersect(x, d.normalize(), 1e-4, d.length(), true)
+                    .intersect(
+                        x,
+                        d.normalize(),
+                        1e-4,
+                        d.length(),
+                        true,
+                        isr::pathtrace::bvh::Cull::BackFaces,
+                    )
                     .is_some()
             })
             .count();
@@ -245,4 +252,61 @@ fn path_tracer_differs_from_the_vpl_reference_where_the_bounce_is_occluded() {
         open_rel < 0.1,
         "on the open floor the two should agree: {open_rel}"
     );
+}
+
+/// Open single-sided occluders shadow as the shadow map does: a quad facing
+/// the light casts a shadow, one facing away from it (culled in the RSM) does
+/// not, in both renderers.
+#[test]
+fn single_sided_occluders_shadow_alike_in_both_renderers() {
+    let gpu = gpu();
+    for (facing_light, shadowed) in [(true, true), (false, false)] {
+        let light = spot(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, 10.0, 40.0, 50.0);
+        let camera = Camera::look_at(
+            Vec3::new(0.0, 0.5, 4.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            50f32.to_radians(),
+            0.1,
+        );
+        let mut scene = floor_scene(light, camera, 3.0, 0.5);
+        let m = scene.add_material("occluder", Vec3::splat(0.5));
+        let v = Vec3::new;
+        let up = [
+            v(-0.2, 1., 0.2),
+            v(0.2, 1., 0.2),
+            v(0.2, 1., -0.2),
+            v(-0.2, 1., -0.2),
+        ];
+        let corners = if facing_light {
+            up
+        } else {
+            [up[3], up[2], up[1], up[0]]
+        };
+        scene.add_quad("occluder", corners, m);
+        let raster = render(
+            &gpu,
+            &scene,
+            &RenderSettings {
+                width: 64,
+                height: 64,
+                ..Default::default()
+            },
+            1,
+        );
+        let traced = pt(&scene, 64, 64, 1, 1);
+        let (x, y) = project(&raster.uniforms, 64, 64, Vec3::ZERO).unwrap();
+        let i = (y * 64 + x) as usize;
+        let unshadowed = light.intensity as f64 * 0.5 / std::f64::consts::PI / 4.0;
+        for (name, direct) in [
+            ("raster", raster.readback.direct[i][0]),
+            ("path traced", traced.direct[i][0]),
+        ] {
+            let dark = (direct as f64) < 0.01 * unshadowed;
+            assert_eq!(
+                dark, shadowed,
+                "{name}: quad facing the light {facing_light}: direct {direct}"
+            );
+        }
+    }
 }

@@ -3,7 +3,15 @@
 //! approximation. The work is split into bands of VPLs, one submission each
 //! (`Renderer` starts a new command buffer per chunk), so no submission runs
 //! long enough to trip a driver's timeout; each band adds into `indirect`.
-//! Pass `reference` (once per chunk; the report sums them):
+//! Pass `reference` (once per chunk; the report sums them). Its time runs from
+//! the previous chunk's end-of-pass timestamp, in the previous submission, so
+//! it includes the gaps between submissions (fence wait, next submit): small
+//! against lavapipe's half-second chunks, not against a GPU's milliseconds.
+//! A start-of-submission timestamp would exclude them on a GPU, but lavapipe
+//! reads a timestamp written before a pass near that pass's end, so there it
+//! would measure nothing. The reference is a ground truth, not a real-time
+//! method; its time is informational.
+//!
 //! `shaders/rsm_gather.frag` with additive blending. Reads the G-buffer and
 //! RSM; writes `indirect` (barriers below).
 

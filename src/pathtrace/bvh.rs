@@ -15,6 +15,18 @@ pub struct Triangle {
     pub double_sided: bool,
 }
 
+/// Which side of single-sided triangles a ray ignores, to see what the
+/// rasterizer sees: camera and bounce rays skip back faces (as culling does);
+/// shadow rays, which travel towards the light, skip the faces turned away
+/// from it (the RSM keeps only faces turned towards the light).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cull {
+    /// Skip single-sided triangles hit from behind.
+    BackFaces,
+    /// Skip single-sided triangles hit from the front.
+    FrontFaces,
+}
+
 /// Where a ray hit, in barycentric terms.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -129,7 +141,11 @@ impl Bvh {
         t_min: f32,
         t_max: f32,
         any: bool,
+        cull: Cull,
     ) -> Option<Hit> {
+        if self.triangles.is_empty() {
+            return None;
+        }
         let inv = dir.recip();
         let mut best: Option<Hit> = None;
         let mut t_far = t_max;
@@ -155,7 +171,7 @@ impl Bvh {
                 continue;
             }
             for &i in &self.order[node.start as usize..(node.start + node.count) as usize] {
-                if let Some((t, u, v)) = self.hit_triangle(i, origin, dir, t_min, t_far) {
+                if let Some((t, u, v)) = self.hit_triangle(i, origin, dir, t_min, t_far, cull) {
                     t_far = t;
                     best = Some(Hit {
                         t,
@@ -172,7 +188,7 @@ impl Bvh {
         best
     }
 
-    /// Möller-Trumbore, skipping back faces of single-sided triangles.
+    /// Möller-Trumbore, skipping one side of single-sided triangles.
     fn hit_triangle(
         &self,
         i: u32,
@@ -180,6 +196,7 @@ impl Bvh {
         d: Vec3A,
         t_min: f32,
         t_max: f32,
+        cull: Cull,
     ) -> Option<(f32, f32, f32)> {
         let tri = &self.triangles[i as usize];
         let e1 = tri.p[1] - tri.p[0];
@@ -187,7 +204,11 @@ impl Bvh {
         let pv = d.cross(e2);
         let det = e1.dot(pv);
         // det > 0: the ray meets the counter-clockwise (front) side.
-        if det.abs() < 1e-12 || (!tri.double_sided && det < 0.0) {
+        let skipped = match cull {
+            Cull::BackFaces => det < 0.0,
+            Cull::FrontFaces => det > 0.0,
+        };
+        if det.abs() < 1e-12 || (!tri.double_sided && skipped) {
             return None;
         }
         let inv = 1.0 / det;
@@ -230,37 +251,42 @@ mod tests {
             .map(|i| tri(-(i as f32) - 1.0, i % 2 == 1))
             .collect();
         let bvh = Bvh::new(tris);
+        let cast = |o: Vec3A, d: Vec3A, any: bool, cull: Cull| {
+            bvh.intersect(o, d, 1e-4, f32::INFINITY, any, cull)
+        };
         // Looking down -z from +z: front faces (normal +z) face the ray.
-        let hit = bvh
-            .intersect(
-                Vec3A::new(0.0, 0.0, 5.0),
-                -Vec3A::Z,
-                1e-4,
-                f32::INFINITY,
-                false,
-            )
-            .unwrap();
+        let hit = cast(Vec3A::new(0.0, 0.0, 5.0), -Vec3A::Z, false, Cull::BackFaces).unwrap();
         assert_eq!(hit.triangle, 0);
         assert!((hit.t - 6.0).abs() < 1e-5);
         // From behind, single-sided triangles (even i) are invisible: the first
         // hit is the double-sided one nearest to z = -60.
-        let back = bvh
+        let back = cast(
+            Vec3A::new(0.0, 0.0, -60.0),
+            Vec3A::Z,
+            false,
+            Cull::BackFaces,
+        )
+        .unwrap();
+        assert_eq!(back.triangle, 49);
+        // Culling front faces instead: from +z, the first hit is double-sided.
+        let front = cast(
+            Vec3A::new(0.0, 0.0, 5.0),
+            -Vec3A::Z,
+            false,
+            Cull::FrontFaces,
+        )
+        .unwrap();
+        assert_eq!(front.triangle, 1);
+        assert!(cast(Vec3A::new(3.0, 0.0, 5.0), -Vec3A::Z, true, Cull::BackFaces).is_none());
+        let empty = Bvh::new(vec![]);
+        assert!(empty
             .intersect(
-                Vec3A::new(0.0, 0.0, -60.0),
+                Vec3A::ZERO,
                 Vec3A::Z,
-                1e-4,
+                0.0,
                 f32::INFINITY,
                 false,
-            )
-            .unwrap();
-        assert_eq!(back.triangle, 49);
-        assert!(bvh
-            .intersect(
-                Vec3A::new(3.0, 0.0, 5.0),
-                -Vec3A::Z,
-                1e-4,
-                f32::INFINITY,
-                true
+                Cull::BackFaces
             )
             .is_none());
     }

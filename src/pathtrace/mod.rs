@@ -15,7 +15,7 @@ pub mod bvh;
 
 use crate::renderer::{frame_uniforms, Readback, RenderSettings, RsmReadback};
 use crate::scene::{Scene, SpotLight};
-use bvh::{Bvh, Triangle};
+use bvh::{Bvh, Cull, Triangle};
 use glam::{Mat4, Vec2, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -132,9 +132,14 @@ impl Shading<'_> {
     }
 
     fn trace(&self, origin: Vec3A, dir: Vec3A) -> Option<SurfacePoint> {
-        let hit = self
-            .bvh
-            .intersect(origin, dir, self.epsilon, f32::INFINITY, false)?;
+        let hit = self.bvh.intersect(
+            origin,
+            dir,
+            self.epsilon,
+            f32::INFINITY,
+            false,
+            Cull::BackFaces,
+        )?;
         let tri = &self.bvh.triangles[hit.triangle as usize];
         let w = 1.0 - hit.u - hit.v;
         let mut normal = (tri.n[0] * w + tri.n[1] * hit.u + tri.n[2] * hit.v).normalize_or_zero();
@@ -175,9 +180,17 @@ impl Shading<'_> {
             return Vec3::ZERO;
         }
         let origin = s.position + s.normal * self.epsilon;
+        // Towards the light: blocked by faces turned to the light, as in the RSM.
         if self
             .bvh
-            .intersect(origin, l, self.epsilon, r * (1.0 - 1e-4), true)
+            .intersect(
+                origin,
+                l,
+                self.epsilon,
+                r * (1.0 - 1e-4),
+                true,
+                Cull::FrontFaces,
+            )
             .is_some()
         {
             return Vec3::ZERO;
@@ -263,8 +276,10 @@ pub fn render(
                     1.0,
                 );
                 let p = clip_to_world * ndc;
-                let dir = (Vec3A::from(p.truncate() / p.w) - eye).normalize();
-                let Some(hit) = shading.trace(eye, dir) else {
+                // From the near plane, which the rasterizer clips at.
+                let near = Vec3A::from(p.truncate() / p.w);
+                let dir = (near - eye).normalize();
+                let Some(hit) = shading.trace(near, dir) else {
                     continue;
                 };
                 let mut rng = Pcg::new(s.seed, (y * w + x) as u64);
