@@ -2,18 +2,16 @@
 //! (ALGORITHM.md section 3 step 6). One instanced draw over every layer
 //! (`shaders/layered.vert` + `shaders/gather.frag`), stencil test EQUAL 1
 //! before the shader. Reads the geometry mips and the RSM quadtree (and the
-//! ISR list); writes the illumination buffer and the evaluation counts.
+//! ISR list); writes the illumination buffer and the evaluation counts
+//! (barriers: `MultiresBuffer::fill_layers`).
 //! Which light patches each eye-space patch gathers is the method's choice
 //! ([`LightPatches`]); [`GatherMethod`] puts the method's passes in order.
 
 use super::isr::IsrSelectPass;
 use super::multires_splat::MultiresSplatPass;
 use crate::multires::{Multires, MultiresBuffer};
-use crate::passes::{
-    begin_rendering, Attachments, FrameContext, StencilAttachment, INDIRECT_GRAPHICS,
-};
+use crate::passes::{FrameContext, INDIRECT_GRAPHICS};
 use crate::renderer::{isr_base_mip, levels_of, FrameInputs, Method, RenderSettings};
-use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, Pipeline, StencilTest};
 use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu};
@@ -90,36 +88,12 @@ impl GatherPass {
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
-        let outputs = [&m.illumination, &m.evaluations];
-        profiler.pass(gpu, cmd, "gather", INDIRECT_GRAPHICS, || unsafe {
-            barrier::transition(
-                gpu,
-                cmd,
-                &outputs,
-                Use::DISCARD_AFTER_READERS,
-                Use::COLOR_ATTACHMENT,
-            );
-            let colors = [m.illumination.view, m.evaluations.view];
-            begin_rendering(
-                gpu,
-                cmd,
-                &Attachments {
-                    extent: m.illumination.extent,
-                    layers: m.illumination.layers,
-                    colors: &colors,
-                    clear_colors: true,
-                    depth: None,
-                    stencil: self.stencil.then_some(StencilAttachment {
-                        view: m.stencil.view,
-                        clear: false,
-                    }),
-                },
-            );
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
-            gpu.device.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
-            gpu.device.cmd_end_rendering(cmd);
-            barrier::transition(gpu, cmd, &outputs, Use::COLOR_ATTACHMENT, Use::READ_ONLY);
+        profiler.pass(gpu, cmd, "gather", INDIRECT_GRAPHICS, || {
+            m.fill_layers(gpu, cmd, self.stencil, || unsafe {
+                self.pipeline
+                    .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+                gpu.device.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
+            });
         });
     }
 

@@ -5,15 +5,12 @@
 //! Pass `splat`: `shaders/multires_splat.vert` + `shaders/multires_splat.frag`,
 //! one instanced draw of N x (L + 1) quads, stencil EQUAL 1 before the shader.
 //! Reads the geometry mips and the RSM quadtree; writes the illumination
-//! buffer and the evaluation counts (barriers below).
+//! buffer and the evaluation counts (barriers: `MultiresBuffer::fill_layers`).
 
 use super::rsm_splat::require_blending;
 use crate::multires::MultiresBuffer;
-use crate::passes::{
-    begin_rendering, Attachments, FrameContext, StencilAttachment, INDIRECT_GRAPHICS,
-};
+use crate::passes::{FrameContext, INDIRECT_GRAPHICS};
 use crate::renderer::FrameInputs;
-use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Binding, Blend, DescriptorSet, GraphicsDesc, Pipeline, StencilTest};
 use crate::vk::profiler::Profiler;
 use crate::vk::Gpu;
@@ -66,38 +63,13 @@ impl MultiresSplatPass {
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
-        let outputs = [&m.illumination, &m.evaluations];
-        profiler.pass(gpu, cmd, "splat", INDIRECT_GRAPHICS, || unsafe {
-            barrier::transition(
-                gpu,
-                cmd,
-                &outputs,
-                Use::DISCARD_AFTER_READERS,
-                Use::COLOR_ATTACHMENT,
-            );
-            // Cleared to zero by the load op, then every splat adds.
-            let colors = [m.illumination.view, m.evaluations.view];
-            begin_rendering(
-                gpu,
-                cmd,
-                &Attachments {
-                    extent: m.illumination.extent,
-                    layers: m.illumination.layers,
-                    colors: &colors,
-                    clear_colors: true,
-                    depth: None,
-                    stencil: Some(StencilAttachment {
-                        view: m.stencil.view,
-                        clear: false,
-                    }),
-                },
-            );
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
-            gpu.device
-                .cmd_draw(cmd, 6, self.vpls * (m.levels + 1), 0, 0);
-            gpu.device.cmd_end_rendering(cmd);
-            barrier::transition(gpu, cmd, &outputs, Use::COLOR_ATTACHMENT, Use::READ_ONLY);
+        profiler.pass(gpu, cmd, "splat", INDIRECT_GRAPHICS, || {
+            m.fill_layers(gpu, cmd, true, || unsafe {
+                self.pipeline
+                    .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+                gpu.device
+                    .cmd_draw(cmd, 6, self.vpls * (m.levels + 1), 0, 0);
+            });
         });
     }
 

@@ -198,6 +198,48 @@ impl MultiresBuffer {
             .sum()
     }
 
+    /// Records `draw` into every layer of the illumination buffer and the
+    /// evaluation counts (both cleared to zero first), testing the stencil
+    /// read-only when `stencil`; the barriers of the pass convention around it.
+    /// The gather and the multiresolution splat fill the buffer this way.
+    pub fn fill_layers(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        stencil: bool,
+        draw: impl FnOnce(),
+    ) {
+        use crate::passes::{begin_rendering, Attachments, StencilAttachment};
+        use crate::vk::barrier::{self, Use};
+        let outputs = [&self.illumination, &self.evaluations];
+        barrier::transition(
+            gpu,
+            cmd,
+            &outputs,
+            Use::DISCARD_AFTER_READERS,
+            Use::COLOR_ATTACHMENT,
+        );
+        let colors = [self.illumination.view, self.evaluations.view];
+        begin_rendering(
+            gpu,
+            cmd,
+            &Attachments {
+                extent: self.illumination.extent,
+                layers: self.illumination.layers,
+                colors: &colors,
+                clear_colors: true,
+                depth: None,
+                stencil: stencil.then_some(StencilAttachment {
+                    view: self.stencil.view,
+                    clear: false,
+                }),
+            },
+        );
+        draw();
+        unsafe { gpu.device.cmd_end_rendering(cmd) };
+        barrier::transition(gpu, cmd, &outputs, Use::COLOR_ATTACHMENT, Use::READ_ONLY);
+    }
+
     pub fn geometry_images(&self) -> [&Image; 5] {
         [
             &self.geo_mean,
