@@ -990,23 +990,7 @@ impl<'g> Renderer<'g> {
     fn clear_indirect(&self) -> Result<()> {
         let gpu = self.gpu;
         let image = &self.targets.indirect;
-        gpu.run_once(|cmd| unsafe {
-            barrier::transition(
-                gpu,
-                cmd,
-                &[image],
-                Use::DISCARD_AFTER_READERS,
-                Use::TRANSFER_DST,
-            );
-            gpu.device.cmd_clear_color_image(
-                cmd,
-                image.image,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &vk::ClearColorValue { float32: [0.0; 4] },
-                &[image.range()],
-            );
-            barrier::transition(gpu, cmd, &[image], Use::TRANSFER_DST, Use::READ_ONLY);
-        })
+        gpu.run_once(|cmd| barrier::clear_color(gpu, cmd, image, Use::READ_ONLY))
     }
 
     /// Records the frame once; every `render_frames` submission replays it.

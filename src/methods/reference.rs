@@ -82,27 +82,7 @@ impl ReferencePass {
         profiler.pass(gpu, cmd, "reference", INDIRECT_GRAPHICS, || unsafe {
             if i == 0 {
                 // Cleared once; every chunk then adds its band of VPLs.
-                barrier::transition(
-                    gpu,
-                    cmd,
-                    &[indirect],
-                    Use::DISCARD_AFTER_READERS,
-                    Use::TRANSFER_DST,
-                );
-                gpu.device.cmd_clear_color_image(
-                    cmd,
-                    indirect.image,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &vk::ClearColorValue { float32: [0.0; 4] },
-                    &[indirect.range()],
-                );
-                barrier::transition(
-                    gpu,
-                    cmd,
-                    &[indirect],
-                    Use::TRANSFER_DST,
-                    Use::COLOR_ATTACHMENT,
-                );
+                barrier::clear_color(gpu, cmd, indirect, Use::COLOR_ATTACHMENT);
             } else {
                 // The previous chunk's blended writes, from the previous submission.
                 barrier::transition(

@@ -159,6 +159,28 @@ pub fn transition(gpu: &Gpu, cmd: vk::CommandBuffer, targets: &[&Image], from: U
     images(gpu, cmd, &barriers);
 }
 
+/// Clears every mip and layer of a color image to zero (discarding what it
+/// held, after its readers) and leaves it in `then`.
+pub fn clear_color(gpu: &Gpu, cmd: vk::CommandBuffer, image: &Image, then: Use) {
+    transition(
+        gpu,
+        cmd,
+        &[image],
+        Use::DISCARD_AFTER_READERS,
+        Use::TRANSFER_DST,
+    );
+    unsafe {
+        gpu.device.cmd_clear_color_image(
+            cmd,
+            image.image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &vk::ClearColorValue { float32: [0.0; 4] },
+            &[image.range()],
+        );
+    }
+    transition(gpu, cmd, &[image], Use::TRANSFER_DST, then);
+}
+
 /// Makes one compute dispatch's storage writes visible to the next dispatch.
 pub fn compute_to_compute(gpu: &Gpu, cmd: vk::CommandBuffer) {
     let rw = vk::AccessFlags2::from_raw(
