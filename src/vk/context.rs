@@ -106,6 +106,8 @@ pub struct Gpu {
     pub features: OptionalFeatures,
     pub allocator: ManuallyDrop<Mutex<Allocator>>,
     pub command_pool: vk::CommandPool,
+    /// Signalled by each `submit_and_wait`; reused rather than made per submission.
+    submit_fence: vk::Fence,
     debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Object names and command labels, present when VK_EXT_debug_utils is.
     pub debug_device: Option<ash::ext::debug_utils::Device>,
@@ -433,6 +435,7 @@ impl Gpu {
                 None,
             )
         }?;
+        let submit_fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }?;
         // Success: the Gpu owns what the guard held.
         guard.instance = None;
         let debug_utils = guard.debug_utils.take();
@@ -452,6 +455,7 @@ impl Gpu {
             features,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             command_pool,
+            submit_fence,
             debug_utils,
             debug_device,
             validation_log,
@@ -500,18 +504,15 @@ impl Gpu {
 
     /// Submits `cmd` and blocks until the GPU has finished it.
     pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
-        let fence = unsafe {
-            self.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        }?;
+        let fence = self.submit_fence;
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         let result = unsafe {
             self.device
-                .queue_submit2(self.queue, &submit, fence)
+                .reset_fences(&[fence])
+                .and_then(|_| self.device.queue_submit2(self.queue, &submit, fence))
                 .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX))
         };
-        unsafe { self.device.destroy_fence(fence, None) };
         result.map_err(|e| match e {
             vk::Result::ERROR_DEVICE_LOST => anyhow!(
                 "the GPU device was lost (a driver timeout or crash); try a smaller --width/--height or --rsm"
@@ -558,6 +559,7 @@ impl Drop for Gpu {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
+            self.device.destroy_fence(self.submit_fence, None);
             self.device.destroy_command_pool(self.command_pool, None);
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);
