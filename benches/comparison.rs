@@ -44,16 +44,6 @@ fn main() -> anyhow::Result<()> {
         };
         let mut r = Renderer::new(&gpu, &scene, &s)?;
         let stats = r.render_frames(frames, |_| {})?;
-        let totals: Vec<f64> = stats
-            .frames
-            .iter()
-            .map(|f| {
-                f.iter()
-                    .filter(|p| p.kind.indirect)
-                    .filter_map(|p| p.gpu_ms)
-                    .sum()
-            })
-            .collect();
         let out = r.readback()?;
         isr::output::write_png(
             &dir.join(format!("{}.png", method.name())),
@@ -62,7 +52,7 @@ fn main() -> anyhow::Result<()> {
             &out.display,
         )?;
         eprintln!("{}: done", method.name());
-        Ok((out, isr::report::median(&totals).unwrap_or(f64::NAN)))
+        Ok((out, stats.gpu_ms_median(true).unwrap_or(f64::NAN)))
     };
     let (reference, reference_ms) = run(Method::Reference, 1)?;
     let traced = isr::pathtrace::render(

@@ -22,23 +22,13 @@ fn run(gpu: &Gpu, label: &str, s: &RenderSettings, frames: u32) -> anyhow::Resul
     let mut r = Renderer::new(gpu, &scene, s)?;
     r.render_frames(1, |_| {})?;
     let stats = r.render_frames(frames, |_| {})?;
-    let totals: Vec<f64> = stats
-        .frames
-        .iter()
-        .map(|f| {
-            f.iter()
-                .filter(|p| p.kind.indirect)
-                .filter_map(|p| p.gpu_ms)
-                .sum()
-        })
-        .collect();
     let m = r.readback_multires()?.unwrap();
     let light = isr::debug_view::light_patch_stats(&m, None);
     let indirect = r.readback()?.indirect;
     eprintln!("{label}: done");
     Ok(Run {
         label: label.into(),
-        indirect_ms: isr::report::median(&totals).unwrap_or(f64::NAN),
+        indirect_ms: stats.gpu_ms_median(true).unwrap_or(f64::NAN),
         patches_per_eye_patch: light.per_patch_mean,
         indirect,
     })

@@ -581,6 +581,24 @@ pub struct FrameStats {
     pub patches_per_level: Option<Vec<u32>>,
 }
 
+impl FrameStats {
+    /// Median over frames of the summed time of all passes, or of the passes
+    /// that exist only for indirect light; `None` without timestamps.
+    pub fn gpu_ms_median(&self, indirect_only: bool) -> Option<f64> {
+        let sums: Vec<f64> = self
+            .frames
+            .iter()
+            .filter_map(|f| {
+                f.iter()
+                    .filter(|p| !indirect_only || p.kind.indirect)
+                    .map(|p| p.gpu_ms)
+                    .try_fold(0.0, |acc, ms| Some(acc + ms?))
+            })
+            .collect();
+        crate::report::median(&sums)
+    }
+}
+
 /// Image contents copied back to the host, rows top to bottom, RGBA f32.
 pub struct Readback {
     pub width: u32,

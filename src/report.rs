@@ -89,18 +89,6 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
             }
         })
         .collect();
-    let frame_sum = |indirect_only: bool| -> Vec<f64> {
-        stats
-            .frames
-            .iter()
-            .filter_map(|f| {
-                f.iter()
-                    .filter(|p| !indirect_only || p.kind.indirect)
-                    .map(|p| p.gpu_ms)
-                    .try_fold(0.0, |acc, ms| Some(acc + ms?))
-            })
-            .collect()
-    };
     TimingReport {
         device: info.device.into(),
         driver: info.driver.into(),
@@ -111,8 +99,8 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         method: info.method.into(),
         frames: stats.frames.len(),
         passes,
-        total_gpu_ms_median: median(&frame_sum(false)),
-        indirect_gpu_ms_median: median(&frame_sum(true)),
+        total_gpu_ms_median: stats.gpu_ms_median(false),
+        indirect_gpu_ms_median: stats.gpu_ms_median(true),
         wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
         patches_per_level: stats.patches_per_level.clone(),
         light_patches: None,
