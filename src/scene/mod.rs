@@ -152,6 +152,17 @@ impl Camera {
     }
 }
 
+/// What changes from frame to frame: where the camera and the light are and
+/// where every mesh instance is. The renderer takes one per frame
+/// (`Renderer::update`); nothing else about the scene changes between frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameState {
+    pub camera: Camera,
+    pub light: SpotLight,
+    /// World transform of each `Scene::instances` entry, in the same order.
+    pub instance_transforms: Vec<Mat4>,
+}
+
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
@@ -230,6 +241,16 @@ impl Scene {
             }
         }
         (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// The scene as loaded: its camera, its light and every instance at its
+    /// loaded transform.
+    pub fn rest_state(&self) -> FrameState {
+        FrameState {
+            camera: self.camera,
+            light: self.light,
+            instance_transforms: self.instances.iter().map(|i| i.world_from_object).collect(),
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
