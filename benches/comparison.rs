@@ -6,8 +6,10 @@
 //! of the indirect and final images; writes `target/bench/comparison.json` and
 //! one PNG per method to `target/bench/comparison/`.
 
-use isr::renderer::{Method, Readback, RenderSettings, Renderer};
+use isr::readback::Readback;
+use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
+use isr::settings::{Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
 

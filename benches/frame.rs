@@ -3,9 +3,10 @@
 //! Speed targets live here, not in tests. On lavapipe absolute times mean
 //! little; compare passes and methods measured in the same run.
 
-use isr::renderer::{RenderSettings, Renderer};
+use isr::renderer::Renderer;
 use isr::report;
 use isr::scene::cornell::cornell_box;
+use isr::settings::RenderSettings;
 use isr::vk::{Gpu, GpuOptions};
 
 fn main() -> anyhow::Result<()> {

@@ -5,8 +5,9 @@
 //! eye-space patches, so the error is the light-space choice alone.
 //! Writes `target/bench/light_space.json`.
 
-use isr::renderer::{LightTreeSettings, Method, RenderSettings, Renderer};
+use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
+use isr::settings::{LightTreeSettings, Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
 

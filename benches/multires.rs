@@ -1,5 +1,5 @@
 //! `cargo bench --bench multires`: what early stencil rejection saves in the
-//! multiresolution gather (ALGORITHM.md section 3, step 6), for the built-in
+//! multiresolution gather (docs/algorithm.md section 3, step 6), for the built-in
 //! Cornell box at 512x512 with 256 VPLs, and where the remaining cost goes.
 //!
 //! Lavapipe shades stencil-survivors in 4x2-pixel groups: a group with one
@@ -7,8 +7,9 @@
 //! query) this counts the live 4x2 groups per level from the stencil, which
 //! predicts the work lavapipe really does. Writes `target/bench/multires.json`.
 
-use isr::renderer::{Method, RenderSettings, Renderer};
+use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
+use isr::settings::{Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
 
@@ -44,13 +45,7 @@ fn main() -> anyhow::Result<()> {
         let last = stats.frames.last().unwrap();
         let gather = last.iter().find(|p| p.name == "gather").unwrap();
         let m = r.readback_multires()?.unwrap();
-        let area = r
-            .gather_method
-            .as_ref()
-            .unwrap()
-            .multires
-            .buffer
-            .total_area();
+        let area = r.multires().unwrap().total_area();
         // Live 4x2 groups per level, from the stencil.
         let mut groups = Vec::new();
         let mut patches = Vec::new();

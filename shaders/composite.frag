@@ -1,15 +1,14 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Final radiance (ALGORITHM.md section 2): direct + rho/pi * E_indirect.
+// Final radiance (docs/algorithm.md section 2): direct + rho/pi * E_indirect.
 // Indirect irradiance is multiplied by the full-resolution albedo here, so
 // coarse illumination patches never blur textures.
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D direct_radiance;
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_albedo;
-layout(set = 0, binding = 3) uniform sampler2D indirect_irradiance;
+layout(set = 1, binding = 0) uniform sampler2D direct_radiance;
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_albedo;
+layout(set = 1, binding = 2) uniform sampler2D indirect_irradiance;
 
 layout(location = 0) out vec4 out_radiance;  // rgb: W/(m^2 sr)
 

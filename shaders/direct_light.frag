@@ -1,25 +1,24 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Direct light (ALGORITHM.md section 2):
+// Direct light (docs/algorithm.md section 2):
 //   L_direct = rho/pi * I(w) * max(0, n.l) / r^2 * V
 // with V from the RSM depth: 3x3 taps of hardware 2x2 PCF.
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D gbuffer_position;
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_normal;
-layout(set = 0, binding = 3) uniform sampler2D gbuffer_albedo;
-layout(set = 0, binding = 4) uniform sampler2DShadow rsm_depth;  // compare: GREATER_OR_EQUAL
+layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
+layout(set = 1, binding = 2) uniform sampler2D gbuffer_albedo;
+layout(set = 1, binding = 3) uniform sampler2DShadow rsm_depth;  // compare: GREATER_OR_EQUAL
 
 layout(location = 0) out vec4 out_radiance;  // rgb: W/(m^2 sr)
 
 float visibility(vec3 p, vec3 n, float cos_i) {
-    float res = u.light_cone.w;
+    float res = float(run.size.z);
     float dist = dot(p - u.light_position.xyz, u.light_direction.xyz);
     // One RSM texel spans this many metres at the receiver's depth.
     float texel_world = 2.0 * u.light_cone.z * max(dist, 0.0) / res;
-    vec4 clip = u.light_view_proj * vec4(p + n * (u.shadow.x * texel_world), 1.0);
+    vec4 clip = u.light_view_proj * vec4(p + n * (run.shadow.x * texel_world), 1.0);
     if (clip.w <= 0.0) return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
@@ -30,8 +29,8 @@ float visibility(vec3 p, vec3 n, float cos_i) {
     // relative change of z (d(near/z) / (near/z) = -dz / z).
     float tan_theta = min(sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-3), 20.0);
     float texel_angle = 2.0 * u.light_cone.z / res;
-    float ref = ndc.z * (1.0 + u.shadow.y + u.shadow.w * texel_angle * tan_theta);
-    float radius = u.shadow.z;
+    float ref = ndc.z * (1.0 + run.shadow.y + run.shadow.w * texel_angle * tan_theta);
+    float radius = run.shadow.z;
     float sum = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)

@@ -1,16 +1,16 @@
 #version 460
-// Stenciled gathering (ALGORITHM.md section 3, step 6): one draw over every
+// Stenciled gathering (docs/algorithm.md section 3, step 6): one draw over every
 // layer of the illumination buffer; the stencil test (EQUAL 1) runs before the
 // shader, so only patches are shaded. Each patch sums C_{j->i} / rho_i over its
 // light patches at its mean position and normal. Which light patches, is the
-// method (ALGORITHM.md section 4), chosen by LIGHT_PATCHES:
+// method (docs/algorithm.md section 4), chosen by LIGHT_PATCHES:
 //   0  regular N VPLs: level k of the RSM quadtree   (multires-gather)
 //   1  the list Basic ISR chose this frame            (isr)
 //   2  a per-fragment traversal of the quadtree       (hisr)
 // With the stencil off (a measurement baseline) every texel is shaded and
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 #include "multires.glsl"
 #include "vpl.glsl"
@@ -19,14 +19,13 @@ layout(early_fragment_tests) in;
 
 layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D geo_mean;    // mip chain
-layout(set = 0, binding = 2) uniform sampler2D geo_normal;  // mip chain
-layout(set = 0, binding = 3) uniform usampler2D geo_flags;  // mip chain
-layout(set = 0, binding = 4) uniform sampler2D rsm_position;  // quadtree (mip chain)
-layout(set = 0, binding = 5) uniform sampler2D rsm_normal;
-layout(set = 0, binding = 6) uniform sampler2D rsm_flux;
-layout(set = 0, binding = 7, std430) readonly buffer ChosenPatches {
+layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // mip chain
+layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // mip chain
+layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // mip chain
+layout(set = 1, binding = 3) uniform sampler2D rsm_position;  // quadtree (mip chain)
+layout(set = 1, binding = 4) uniform sampler2D rsm_normal;
+layout(set = 1, binding = 5) uniform sampler2D rsm_flux;
+layout(set = 1, binding = 6, std430) readonly buffer ChosenPatches {
     uint patch_count;
     uint pad0, pad1, pad2;
     LightPatch patches[];
@@ -62,7 +61,7 @@ void chosen_list(vec3 xi, vec3 ni) {
     }
 }
 
-// Hierarchical ISR (ALGORITHM.md section 4): subdivide patch j while its
+// Hierarchical ISR (docs/algorithm.md section 4): subdivide patch j while its
 // contribution to this receiver could exceed tau.
 //
 // The bound. With rho <= 1 and both cosines <= 1, Phi_j = rho_j I dw_j and
@@ -85,10 +84,10 @@ void chosen_list(vec3 xi, vec3 ni) {
 const int STACK_SIZE = 64;
 
 void traverse(vec3 xi, vec3 ni) {
-    int top = u.light_levels.w;  // mip of the single root patch
-    int start = u.light_levels.x;
-    int max_depth = u.light_levels.y;
-    float t_finest = u.light_tree.x;
+    int top = run.light_levels.w;  // mip of the single root patch
+    int start = run.light_levels.x;
+    int max_depth = run.light_levels.y;
+    float t_finest = run.light_tree.x;
     vec3 light = u.light_position.xyz;
     ivec3 stack[STACK_SIZE];  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     int side = 1 << start;
@@ -128,7 +127,7 @@ void main() {
         traverse(xi, ni);
     }
     float is = 1.0;
-    if ((u.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(geo_flags, level, u.hierarchy.x, p)) {
+    if ((run.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(geo_flags, level, run.hierarchy.x, p)) {
         is = 0.0;
         e = vec3(0.0);
         evaluations = 0u;

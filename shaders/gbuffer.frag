@@ -1,9 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// G-buffer from the camera (ALGORITHM.md section 3, step 1).
-#include "shared.glsl"
+// G-buffer from the camera (docs/algorithm.md section 3, step 1).
+#include "frame.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
 layout(push_constant) uniform Push { DrawPush draw; };
 #include "material.glsl"
 

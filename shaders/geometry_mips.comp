@@ -1,5 +1,5 @@
 #version 460
-// One level of the geometry mipmaps (ALGORITHM.md section 3, steps 2-4).
+// One level of the geometry mipmaps (docs/algorithm.md section 3, steps 2-4).
 // Level 0 reads the G-buffer; level l > 0 merges 2x2 texels of level l - 1.
 // Per texel: mean position and view depth, mean normal and coverage, the
 // depth and normal-component ranges, and the flags smooth / split.
@@ -13,32 +13,31 @@
 // l - 1 in the 4x4 block around its children (its children and the ring of
 // their neighbours) splits. So no leaf is adjacent to a leaf two levels finer.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_normal;
+layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
 // Level l - 1 (unused at level 0).
-layout(set = 0, binding = 3, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
-layout(set = 0, binding = 4, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
-layout(set = 0, binding = 5, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
-layout(set = 0, binding = 6, rgba32f) readonly uniform image2D src_max;     // x: max depth; yzw: max normal components
-layout(set = 0, binding = 7, r32ui) readonly uniform uimage2D src_flags;
+layout(set = 1, binding = 2, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
+layout(set = 1, binding = 3, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
+layout(set = 1, binding = 4, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
+layout(set = 1, binding = 5, rgba32f) readonly uniform image2D src_max;     // x: max depth; yzw: max normal components
+layout(set = 1, binding = 6, r32ui) readonly uniform uimage2D src_flags;
 // Level l.
-layout(set = 0, binding = 8, rgba32f) writeonly uniform image2D dst_mean;
-layout(set = 0, binding = 9, rgba32f) writeonly uniform image2D dst_normal;
-layout(set = 0, binding = 10, rgba32f) writeonly uniform image2D dst_min;
-layout(set = 0, binding = 11, rgba32f) writeonly uniform image2D dst_max;
-layout(set = 0, binding = 12, r32ui) writeonly uniform uimage2D dst_flags;
+layout(set = 1, binding = 7, rgba32f) writeonly uniform image2D dst_mean;
+layout(set = 1, binding = 8, rgba32f) writeonly uniform image2D dst_normal;
+layout(set = 1, binding = 9, rgba32f) writeonly uniform image2D dst_min;
+layout(set = 1, binding = 10, rgba32f) writeonly uniform image2D dst_max;
+layout(set = 1, binding = 11, r32ui) writeonly uniform uimage2D dst_flags;
 
 layout(push_constant) uniform Push { int level; };
 
 const float BIG = 3.0e38;
 
 bool smooth_ranges(vec4 lo, vec4 hi) {
-    bool depth_ok = (hi.x - lo.x) < u.refine.x * lo.x;
-    bool normal_ok = length(hi.yzw - lo.yzw) < u.refine.y;
+    bool depth_ok = (hi.x - lo.x) < run.refine.x * lo.x;
+    bool normal_ok = length(hi.yzw - lo.yzw) < run.refine.y;
     return depth_ok && normal_ok;
 }
 
@@ -55,7 +54,7 @@ void level_zero(ivec2 p) {
     // Renormalised: the G-buffer stores normals as 16-bit floats.
     vec3 n = normalize(texelFetch(gbuffer_normal, p, 0).xyz);
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
-    ivec2 size = ivec2(u.size.xy);
+    ivec2 size = ivec2(run.size.xy);
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = p + ivec2(dx, dy);

@@ -1,5 +1,5 @@
 #version 460
-// Basic ISR patch selection (ALGORITHM.md section 4): from the dense base
+// Basic ISR patch selection (docs/algorithm.md section 4): from the dense base
 // level b of the RSM quadtree, merge into the largest valid patches and append
 // them to one list that every eye-space patch then gathers from. No CPU round
 // trip: one dispatch over the base level.
@@ -13,22 +13,21 @@
 // every chosen patch is appended exactly once and the chosen patches
 // partition the RSM.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D rsm_position;  // quadtree (mip chain)
-layout(set = 0, binding = 2) uniform sampler2D rsm_normal;
-layout(set = 0, binding = 3) uniform sampler2D rsm_flux;
-layout(set = 0, binding = 4, std430) buffer ChosenPatches {
+layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
+layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
+layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
+layout(set = 1, binding = 3, std430) buffer ChosenPatches {
     uint count;
     uint pad0, pad1, pad2;
     LightPatch patches[];
 };
 
 void main() {
-    int base = u.light_levels.z;
-    int top = u.light_levels.w;
+    int base = run.light_levels.z;
+    int top = run.light_levels.w;
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, textureSize(rsm_position, base)))) return;
     int level = base;

@@ -1,4 +1,4 @@
-// Spot light radiometry (ALGORITHM.md section 2) shared by the RSM and direct passes.
+// Spot light radiometry (docs/algorithm.md section 2) shared by the RSM and direct passes.
 #ifndef LIGHTING_GLSL
 #define LIGHTING_GLSL
 

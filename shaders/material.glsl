@@ -4,8 +4,8 @@
 
 layout(constant_id = 0) const int TEXTURE_COUNT = 1;
 
-layout(set = 0, binding = 1, std430) readonly buffer Materials { MaterialGpu materials[]; };
-layout(set = 0, binding = 2) uniform sampler2D textures[TEXTURE_COUNT];
+layout(set = 1, binding = 0, std430) readonly buffer Materials { MaterialGpu materials[]; };
+layout(set = 1, binding = 1) uniform sampler2D textures[TEXTURE_COUNT];
 
 vec3 material_albedo(uint material, vec2 uv) {
     MaterialGpu m = materials[material];

@@ -1,4 +1,4 @@
-// The multiresolution illumination buffer's patch test (ALGORITHM.md section 3,
+// The multiresolution illumination buffer's patch test (docs/algorithm.md section 3,
 // step 4), shared by the stenciled refinement and the unstenciled gather.
 #ifndef MULTIRES_GLSL
 #define MULTIRES_GLSL

@@ -3,13 +3,13 @@
 // position and normal), added by the blend state (color ONE + ONE, alpha MAX,
 // so alpha = 1 marks the patches as the gather does). See multires_splat.vert.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 #include "vpl.glsl"
 
 layout(early_fragment_tests) in;
 
-layout(set = 0, binding = 1) uniform sampler2D geo_mean;    // mip chain
-layout(set = 0, binding = 2) uniform sampler2D geo_normal;  // mip chain
+layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // mip chain
+layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // mip chain
 
 layout(location = 0) flat in int level;
 layout(location = 1) flat in vec4 in_position;

@@ -1,4 +1,4 @@
-// The N regular VPLs of ALGORITHM.md section 4: the sqrt(N) x sqrt(N) level k
+// The N regular VPLs of docs/algorithm.md section 4: the sqrt(N) x sqrt(N) level k
 // of the RSM quadtree (patch means), or with HIERARCHY_POINT_VPLS the texel at
 // each patch's centre with flux and area scaled by the 4^k texels it stands
 // for. Include after declaring `u` and the samplers rsm_position, rsm_normal
@@ -6,14 +6,14 @@
 #ifndef REGULAR_VPLS_GLSL
 #define REGULAR_VPLS_GLSL
 
-int regular_vpl_count() { return u.hierarchy.z * u.hierarchy.z; }
+int regular_vpl_count() { return run.hierarchy.z * run.hierarchy.z; }
 
 // VPL j in row-major order; false when its patch saw nothing lit.
 bool regular_vpl(int j, out vec4 pos, out vec4 nrm, out vec3 flux) {
-    int k = u.hierarchy.y;
-    int side = u.hierarchy.z;
+    int k = run.hierarchy.y;
+    int side = run.hierarchy.z;
     ivec2 xy = ivec2(j % side, j / side);
-    if ((u.hierarchy.w & HIERARCHY_POINT_VPLS) != 0) {
+    if ((run.hierarchy.w & HIERARCHY_POINT_VPLS) != 0) {
         int span = 1 << k;  // RSM texels per VPL side
         ivec2 t = xy * span + span / 2;
         float texels = float(span * span);

@@ -1,12 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Reflective shadow map (ALGORITHM.md section 2). Texel j holds the point x_j it
+// Reflective shadow map (docs/algorithm.md section 2). Texel j holds the point x_j it
 // sees, its normal n_j, the VPL flux Phi_j = rho_j * I(w_j) * dw_j and world
 // area A_j = dw_j * r_j^2 / cos_j. Depth goes to the depth attachment.
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
 layout(push_constant) uniform Push { DrawPush draw; };
 #include "material.glsl"
 
@@ -25,7 +24,7 @@ const float MIN_COS_J = 0.01;
 
 void main() {
     vec3 n = facing_normal(in_normal);
-    float res = u.light_cone.w;
+    float res = float(run.size.z);
     float tan_half = u.light_cone.z;
     // The texel center's point on the image plane at unit distance from the light.
     vec2 plane = (gl_FragCoord.xy / res * 2.0 - 1.0) * tan_half;

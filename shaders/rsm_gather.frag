@@ -1,20 +1,19 @@
 #version 460
-// Method rsm-gather (ALGORITHM.md section 5, Dachsbacher & Stamminger 2005):
+// Method rsm-gather (docs/algorithm.md section 5, Dachsbacher & Stamminger 2005):
 // every full-resolution pixel gathers the N regular VPLs,
 //   E = sum_j Phi_j cos_i cos_j / (pi d^2 + A_j).
 // Pass `reference` runs the same shader over every RSM texel (N = R^2), a
 // band of VPL rows per submission, adding into the target.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 #include "vpl.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D gbuffer_position;
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_normal;
-layout(set = 0, binding = 3) uniform sampler2D rsm_position;  // quadtree (mip chain)
-layout(set = 0, binding = 4) uniform sampler2D rsm_normal;
-layout(set = 0, binding = 5) uniform sampler2D rsm_flux;
+layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
+layout(set = 1, binding = 2) uniform sampler2D rsm_position;  // quadtree (mip chain)
+layout(set = 1, binding = 3) uniform sampler2D rsm_normal;
+layout(set = 1, binding = 4) uniform sampler2D rsm_flux;
 #include "regular_vpls.glsl"
 
 // VPLs first .. last - 1 (row-major); the whole set unless `reference` splits it.

@@ -1,5 +1,5 @@
 #version 460
-// One level of the RSM quadtree (ALGORITHM.md section 2, "A patch P"): each
+// One level of the RSM quadtree (docs/algorithm.md section 2, "A patch P"): each
 // texel of level k merges its four children of level k-1. Flux and solid angle
 // add up, area adds up, position is the area-weighted mean and the normal the
 // normalised area-weighted mean.
@@ -12,17 +12,16 @@
 // a flag; since validity needs valid children, a discontinuity anywhere below
 // invalidates every ancestor.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
 
-layout(set = 0, binding = 1, rgba32f) readonly uniform image2D src_position;  // xyz: position; w: area A
-layout(set = 0, binding = 2, rgba32f) readonly uniform image2D src_normal;    // xyz: normal; w: PATCH_*
-layout(set = 0, binding = 3, rgba32f) readonly uniform image2D src_flux;      // rgb: flux; a: solid angle
-layout(set = 0, binding = 4, rgba32f) writeonly uniform image2D dst_position;
-layout(set = 0, binding = 5, rgba32f) writeonly uniform image2D dst_normal;
-layout(set = 0, binding = 6, rgba32f) writeonly uniform image2D dst_flux;
+layout(set = 1, binding = 0, rgba32f) readonly uniform image2D src_position;  // xyz: position; w: area A
+layout(set = 1, binding = 1, rgba32f) readonly uniform image2D src_normal;    // xyz: normal; w: PATCH_*
+layout(set = 1, binding = 2, rgba32f) readonly uniform image2D src_flux;      // rgb: flux; a: solid angle
+layout(set = 1, binding = 3, rgba32f) writeonly uniform image2D dst_position;
+layout(set = 1, binding = 4, rgba32f) writeonly uniform image2D dst_normal;
+layout(set = 1, binding = 5, rgba32f) writeonly uniform image2D dst_flux;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -56,8 +55,8 @@ void main() {
         for (int i = 0; i < 4; ++i) {
             if (child_normal[i].w == PATCH_EMPTY) continue;
             float offset = abs(dot(child_position[i].xyz - position, normal));
-            float reach = u.light_tree.y * distance(child_position[i].xyz, u.light_position.xyz);
-            one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > u.light_tree.z;
+            float reach = run.light_tree.y * distance(child_position[i].xyz, u.light_position.xyz);
+            one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > run.light_tree.z;
         }
         state = one_surface ? PATCH_VALID : PATCH_INVALID;
     }

@@ -4,7 +4,8 @@
 #ifndef SHARED_GLSL
 #define SHARED_GLSL
 
-// Per-frame constants (std140 uniform block, set 0, binding 0 of every pass).
+// What changes every frame: the camera and the light (std140 uniform block,
+// set 0 binding 0, one buffer per frame in flight).
 struct FrameUniforms {
     mat4 camera_view_proj;  // world -> camera clip: reversed-Z, infinite far, y down
     mat4 light_view_proj;   // world -> RSM clip: same conventions, square, covers the outer cone
@@ -12,25 +13,38 @@ struct FrameUniforms {
     vec4 camera_forward;    // xyz: unit view direction
     vec4 light_position;    // xyz: world (m); w: range (m), 0 = no range
     vec4 light_direction;   // xyz: unit spot axis
-    vec4 light_intensity;   // rgb: color * intensity, W/sr (candela read as W/sr)
+    vec4 light_intensity;   // rgb: color * intensity, W/sr (candela read as W/sr); w: I, the
+                            // peak of rgb (W/sr)
     vec4 light_cone;        // x, y: KHR_lights_punctual lightAngleScale, lightAngleOffset;
-                            // z: tan(RSM half field of view); w: RSM resolution R
+                            // z: tan(RSM half field of view); w: unused
+};
+
+// What is fixed for a run: sizes, thresholds, levels (std140 uniform block,
+// set 0 binding 1, written once).
+struct RunUniforms {
     vec4 shadow;            // x: normal offset (RSM texels); y: constant relative depth bias;
                             // z: PCF tap spacing (texels); w: slope bias (texels along the slope)
     vec4 exposure;          // x: multiplier applied before the PNG's sRGB encoding
-    uvec4 size;             // x, y: output width, height; z: RSM resolution
-    vec4 refine;            // multiresolution buffer (ALGORITHM.md section 3): x: depth threshold
+    uvec4 size;             // x, y: output width, height; z: RSM resolution R
+    vec4 refine;            // multiresolution buffer (docs/algorithm.md section 3): x: depth threshold
                             // (relative depth range, (max - min) / min); y: normal threshold (chord
                             // length |n_max - n_min| of the component box, 2 sin(angle / 2))
     ivec4 hierarchy;        // x: coarsest level L; y: RSM quadtree level k of the VPLs;
                             // z: VPLs per side sqrt(N); w: flags, see HIERARCHY_*
-    vec4 light_tree;        // light-space hierarchy (ALGORITHM.md sections 2 and 4): x: HISR's T at
-                            // the finest level, 2 (I - tau) / (3 tau R^2); y: patch validity depth
+    vec4 light_tree;        // light-space hierarchy (docs/algorithm.md sections 2 and 4): x: HISR's T at
+                            // the finest level, 2 (1 - tau) / (3 tau R^2); y: patch validity depth
                             // threshold (relative distance to the light); z: validity normal
-                            // threshold (cosine); w: I, the light's peak intensity (W/sr)
+                            // threshold (cosine); w: unused
     ivec4 light_levels;     // x: HISR start depth (2^x x 2^x patches); y: HISR max depth;
                             // z: ISR base level (RSM mip); w: log2 R, the top mip (one patch)
     vec4 splat;             // x: restricted-splat threshold (irradiance, W/m^2)
+};
+
+// Where one mesh instance is this frame (std430, set 0 binding 2, one per
+// `Scene::instances` entry, one buffer per frame in flight).
+struct InstanceTransform {
+    mat4 world_from_object;
+    mat4 normal_from_object;  // inverse transpose of the upper 3x3 (non-uniform scale)
 };
 
 const float PI = 3.14159265358979323846;
@@ -68,11 +82,8 @@ struct MaterialGpu {
 
 // Push constants of one scene draw.
 struct DrawPush {
-    mat4 world_from_object;
-    uint material;
-    uint pad0;
-    uint pad1;
-    uint pad2;
+    uint instance;  // index into the frame's InstanceTransform array
+    uint material;  // index into the materials
 };
 
 #endif

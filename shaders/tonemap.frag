@@ -2,10 +2,9 @@
 #extension GL_GOOGLE_include_directive : require
 // Display encoding for the PNG: exposure, clamp, sRGB transfer function.
 // The EXR keeps linear radiance; this pass exists only for viewing.
-#include "shared.glsl"
+#include "frame.glsl"
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1) uniform sampler2D final_radiance;
+layout(set = 1, binding = 0) uniform sampler2D final_radiance;
 
 layout(location = 0) out vec4 out_color;  // sRGB-encoded, stored in a UNORM target
 
@@ -15,6 +14,6 @@ vec3 srgb_encode(vec3 c) {
 }
 
 void main() {
-    vec3 c = texelFetch(final_radiance, ivec2(gl_FragCoord.xy), 0).rgb * u.exposure.x;
+    vec3 c = texelFetch(final_radiance, ivec2(gl_FragCoord.xy), 0).rgb * run.exposure.x;
     out_color = vec4(srgb_encode(c), 1.0);
 }

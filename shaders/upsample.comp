@@ -1,5 +1,5 @@
 #version 460
-// Upsampling of the multiresolution illumination buffer (ALGORITHM.md section
+// Upsampling of the multiresolution illumination buffer (docs/algorithm.md section
 // 3, step 7), one level per dispatch.
 //
 // Texel alpha: 1 = a patch the gather shaded; 0.5 = pulled (the mean of its
@@ -13,14 +13,13 @@
 // renormalised over those that hold a value and are on the same surface (no
 // depth or normal discontinuity). Level 0 is written to the indirect image.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
-layout(set = 0, binding = 1, rgba32f) uniform image2DArray illumination;
-layout(set = 0, binding = 2) uniform sampler2D geo_mean;    // w: mean view depth
-layout(set = 0, binding = 3) uniform sampler2D geo_normal;  // w: coverage
-layout(set = 0, binding = 4, rgba32f) writeonly uniform image2D indirect;
+layout(set = 1, binding = 0, rgba32f) uniform image2DArray illumination;
+layout(set = 1, binding = 1) uniform sampler2D geo_mean;    // w: mean view depth
+layout(set = 1, binding = 2) uniform sampler2D geo_normal;  // w: coverage
+layout(set = 1, binding = 3, rgba32f) writeonly uniform image2D indirect;
 
 layout(push_constant) uniform Push {
     int level;
@@ -30,7 +29,7 @@ layout(push_constant) uniform Push {
 const float PULLED = 0.5;
 const float PUSHED = 0.75;
 
-ivec2 level_size(int l) { return ivec2(u.size.xy) >> l; }
+ivec2 level_size(int l) { return ivec2(run.size.xy) >> l; }
 
 bool inside(ivec2 q, int l) { return all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, level_size(l))); }
 
@@ -52,9 +51,9 @@ void pull_texel(ivec2 p) {
 // Same surface: view depths within twice the refinement's relative depth
 // threshold and normals within twice its angle.
 bool same_surface(vec4 mean_a, vec3 n_a, vec4 mean_b, vec3 n_b) {
-    float depth_ok = abs(mean_a.w - mean_b.w) - 2.0 * u.refine.x * min(mean_a.w, mean_b.w);
+    float depth_ok = abs(mean_a.w - mean_b.w) - 2.0 * run.refine.x * min(mean_a.w, mean_b.w);
     float chord = length(n_a - n_b);
-    return depth_ok <= 0.0 && chord <= 2.0 * u.refine.y;
+    return depth_ok <= 0.0 && chord <= 2.0 * run.refine.y;
 }
 
 vec3 interpolate(ivec2 p, vec3 fallback) {
@@ -68,7 +67,7 @@ vec3 interpolate(ivec2 p, vec3 fallback) {
     // At the image border the 2x2 footprint would leave the level: keep it
     // inside, which turns the weights into a linear extrapolation (fractions
     // outside 0..1). Without this, border pixels would repeat the value of a
-    // texel centre up to 3.5 pixels inside (ALGORITHM.md section 3, step 7).
+    // texel centre up to 3.5 pixels inside (docs/algorithm.md section 3, step 7).
     ivec2 clamped = clamp(base, ivec2(0), max(size - 2, ivec2(0)));
     vec2 f = c - vec2(clamped);
     vec3 sum = vec3(0.0);
@@ -111,7 +110,7 @@ void push_texel(ivec2 p) {
     if (v.a <= 0.0 && geometry) {
         ivec2 parent = p >> 1;
         vec3 nearest = inside(parent, level + 1) ? imageLoad(illumination, ivec3(parent, level + 1)).rgb : vec3(0.0);
-        bool interpolated = (u.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
+        bool interpolated = (run.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
         v = vec4(interpolated ? interpolate(p, nearest) : nearest, PUSHED);
         imageStore(illumination, ivec3(p, level), v);
     }

@@ -1,4 +1,4 @@
-// Light patches and their contribution to a receiver (ALGORITHM.md section 2).
+// Light patches and their contribution to a receiver (docs/algorithm.md section 2).
 #ifndef VPL_GLSL
 #define VPL_GLSL
 

@@ -2,12 +2,12 @@
 // One VPL's irradiance at this pixel, added into the target by the blend
 // state (ONE + ONE). See vpl_splat.vert.
 #extension GL_GOOGLE_include_directive : require
-#include "shared.glsl"
+#include "frame.glsl"
 #include "lighting.glsl"
 #include "vpl.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D gbuffer_position;
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_normal;
+layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
 
 layout(location = 0) flat in vec4 in_position;
 layout(location = 1) flat in vec3 in_normal;

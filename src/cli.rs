@@ -1,8 +1,10 @@
 //! The `isr` command line: argument parsing and the `render`, `devices` and
 //! `export-builtin` commands. `main.rs` only calls [`run`].
 
-use crate::multires::{MultiresSettings, Upsample};
-use crate::renderer::{LightTreeSettings, Method, RenderSettings, Renderer, VplSampling};
+use crate::renderer::Renderer;
+use crate::settings::{
+    LightTreeSettings, Method, MultiresSettings, RenderSettings, Upsample, VplSampling,
+};
 use crate::vk::{Gpu, GpuOptions, Validation};
 use crate::{output, report, scene};
 use anyhow::{bail, Context as _, Result};
@@ -33,22 +35,26 @@ enum Command {
     },
 }
 
+/// Every default below comes from `RenderSettings::DEFAULT`, which the
+/// library and the benchmarks use too.
+const D: RenderSettings = RenderSettings::DEFAULT;
+
 #[derive(Args)]
 struct RenderArgs {
     /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
     #[arg(long)]
     scene: Option<PathBuf>,
     /// How indirect light is computed.
-    #[arg(long, value_enum, default_value_t = Method::MultiresGather)]
+    #[arg(long, value_enum, default_value_t = D.method)]
     method: Method,
     /// Output width in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = D.width)]
     width: u32,
     /// Output height in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = D.height)]
     height: u32,
     /// Reflective shadow map resolution R (R x R, a power of two).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = D.rsm_resolution)]
     rsm: u32,
     /// Frames to render; timings are medians over them.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000))]
@@ -63,7 +69,7 @@ struct RenderArgs {
     #[arg(long)]
     timings: Option<PathBuf>,
     /// Multiplier on radiance before the PNG's sRGB encoding.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = D.exposure)]
     exposure: f32,
     /// Load the Khronos validation layer with synchronization validation; exit
     /// non-zero if it reports anything.
@@ -73,10 +79,10 @@ struct RenderArgs {
     #[arg(long)]
     device: Option<usize>,
     /// Regular VPLs (a power of 4): the sqrt(N) x sqrt(N) level of the RSM quadtree.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = D.vpls)]
     vpls: u32,
     /// A VPL is its patch's mean, or the patch's centre texel with scaled flux.
-    #[arg(long, value_enum, default_value_t = VplSampling::Mean)]
+    #[arg(long, value_enum, default_value_t = D.vpl_sampling)]
     vpl_sampling: VplSampling,
     /// Coarsest level L of the multiresolution buffer (texels of 2^L x 2^L
     /// pixels); default: about 1/16 of the shorter side (5 at 512).
@@ -84,26 +90,26 @@ struct RenderArgs {
     levels: Option<u32>,
     /// Split a texel when its view-depth range relative to its nearest depth,
     /// (max - min) / min, is not below this.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = D.multires.depth_threshold)]
     depth_threshold: f32,
     /// Split a texel when its normals span this angle (degrees) or more.
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = D.multires.normal_threshold_deg)]
     normal_threshold: f32,
     /// Upsampling of the multiresolution buffer to full resolution.
-    #[arg(long, value_enum, default_value_t = Upsample::Interpolated)]
+    #[arg(long, value_enum, default_value_t = D.multires.upsample)]
     upsample: Upsample,
     /// Early stencil rejection in the gather; `off` shades every texel of every
     /// level and masks afterwards (to measure what the stencil saves).
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    #[arg(long, value_enum, default_value_t = if D.multires.stencil { OnOff::On } else { OnOff::Off })]
     stencil: OnOff,
     /// Print patch counts per level (also recorded in the timings JSON).
     #[arg(long)]
     stats: bool,
     /// Basic ISR's dense starting level, in patches per side (a power of 2).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = D.light_tree.isr_base)]
     isr_base: u32,
     /// HISR starts its traversal from 2^s x 2^s light patches.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = D.light_tree.start_level)]
     start_level: u32,
     /// HISR subdivides at most down to 2^d x 2^d patches (at most log2 of
     /// --rsm; default 6, or log2 of --rsm if smaller); patches spanning a
@@ -112,19 +118,19 @@ struct RenderArgs {
     max_depth: Option<u32>,
     /// HISR's error threshold, as a fraction of the light's peak intensity: a
     /// light patch is subdivided while its contribution could exceed tau * I.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = D.light_tree.tau)]
     tau: f32,
     /// Light patches merge only when each child lies within this fraction of
     /// its distance to the light from the merged patch's plane.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = D.light_tree.depth_threshold)]
     light_depth_threshold: f32,
     /// ... and their normals by less than this angle (degrees).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = D.light_tree.normal_threshold_deg)]
     light_normal_threshold: f32,
     /// --method reference: light-patch evaluations per submission (pixels x
     /// VPLs). The default keeps a submission near half a second on lavapipe;
     /// on a GPU, larger chunks cut the per-submission overhead.
-    #[arg(long, default_value_t = 1 << 26)]
+    #[arg(long, default_value_t = D.reference_chunk)]
     reference_chunk: u64,
     /// Indirect samples per pixel for --method pathtrace.
     #[arg(long, default_value_t = 64)]
@@ -134,7 +140,7 @@ struct RenderArgs {
     seed: u64,
     /// Restricted splats: a VPL's quad covers only where its irradiance bound
     /// Phi / (pi d^2) exceeds this (W/m^2); 0 gives full-screen splats.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = D.splat_threshold)]
     splat_threshold: f32,
     /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
     /// patch, `indirect` shows the indirect light alone, `vpl-count` is a heat
@@ -208,13 +214,23 @@ fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
     let ms = started.elapsed().as_secs_f64() * 1e3;
     println!("pathtrace: {ms:.1} ms on {threads} CPU threads");
     if let Some(path) = &args.timings {
-        let report = serde_json::json!({
-            "device": format!("CPU ({threads} threads)"), "driver": "isr::pathtrace", "scene": scene.name,
-            "width": args.width, "height": args.height, "method": "pathtrace", "frames": 1, "spp": args.spp,
-            "passes": [], "total_gpu_ms_median": null, "indirect_gpu_ms_median": null, "wall_ms_median": ms,
-        });
-        std::fs::write(path, serde_json::to_string_pretty(&report)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        let r = report::TimingReport {
+            device: format!("CPU ({threads} threads)"),
+            driver: "isr::pathtrace".into(),
+            scene: scene.name.clone(),
+            width: args.width,
+            height: args.height,
+            rsm: 0,
+            method: Method::Pathtrace.name().into(),
+            frames: 1,
+            passes: vec![],
+            total_gpu_ms_median: None,
+            indirect_gpu_ms_median: None,
+            wall_ms_median: ms,
+            patches_per_level: None,
+            light_patches: None,
+        };
+        report::write_json(path, &r)?;
         println!("wrote {}", path.display());
     }
     output::write_exr(&args.out, &result)?;
@@ -308,7 +324,7 @@ fn render(args: RenderArgs) -> Result<()> {
     if args.method == Method::Pathtrace {
         return pathtrace(&args, &scene);
     }
-    if scene.light.outer_cone > crate::renderer::MAX_RSM_HALF_FOV {
+    if scene.light.outer_cone > crate::view::MAX_RSM_HALF_FOV {
         eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");
     }
     let gpu = Gpu::new(&GpuOptions {
@@ -400,10 +416,7 @@ fn render(args: RenderArgs) -> Result<()> {
         };
         extra_views.push((suffix, what, rgba));
     }
-    let total_area = renderer
-        .gather_method
-        .as_ref()
-        .map(|m| m.multires.buffer.total_area());
+    let total_area = renderer.multires().map(|m| m.total_area());
     drop(renderer);
 
     let r = report::build(
@@ -434,12 +447,7 @@ fn render(args: RenderArgs) -> Result<()> {
         }
     }
     if let Some(path) = &args.timings {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-        }
-        std::fs::write(path, serde_json::to_string_pretty(&r)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        report::write_json(path, &r)?;
         println!("wrote {}", path.display());
     }
     output::write_exr(&args.out, &result)?;

@@ -1,6 +1,6 @@
 //! Debug pictures computed on the host from read-back images.
 
-use crate::renderer::{MultiresReadback, Readback};
+use crate::readback::{MultiresReadback, Readback};
 
 /// Colors of levels 0, 1, 2, ... (cycled past the end).
 const PALETTE: [[u8; 3]; 8] = [

@@ -1,9 +1,13 @@
 //! Host mirrors of the structs in `shaders/shared.glsl`. `tests/layouts.rs`
-//! checks every size and offset here against the compiled SPIR-V.
+//! checks every size and offset here against the compiled SPIR-V. All are
+//! `Pod`: uploads and readbacks go through `bytemuck`, and a struct with
+//! padding does not compile.
 
-/// `FrameUniforms` (std140): per-frame constants of every pass.
+use bytemuck::{Pod, Zeroable};
+
+/// `FrameUniforms` (std140): what changes every frame, the camera and the light.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
     pub camera_view_proj: [[f32; 4]; 4],
     pub light_view_proj: [[f32; 4]; 4],
@@ -12,10 +16,16 @@ pub struct FrameUniforms {
     /// w: range in metres, 0 = none.
     pub light_position: [f32; 4],
     pub light_direction: [f32; 4],
-    /// rgb: color * intensity in W/sr.
+    /// rgb: color * intensity in W/sr; w: the peak of rgb, I.
     pub light_intensity: [f32; 4],
-    /// x, y: KHR angle scale and offset; z: tan(RSM half fov); w: RSM resolution.
+    /// x, y: KHR angle scale and offset; z: tan(RSM half fov); w: unused.
     pub light_cone: [f32; 4],
+}
+
+/// `RunUniforms` (std140): what is fixed for a run.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RunUniforms {
     /// x: normal offset (RSM texels); y: constant relative depth bias; z: PCF tap
     /// spacing (texels); w: slope-scaled bias (texels along the slope).
     pub shadow: [f32; 4],
@@ -29,8 +39,7 @@ pub struct FrameUniforms {
     /// side; w: `HIERARCHY_*` flags.
     pub hierarchy: [i32; 4],
     /// x: HISR's T at the finest level; y: patch validity depth threshold
-    /// (relative distance to the light); z: validity normal threshold (cosine);
-    /// w: the light's peak intensity I (W/sr).
+    /// (relative distance to the light); z: validity normal threshold (cosine).
     pub light_tree: [f32; 4],
     /// x: HISR start depth; y: HISR max depth; z: ISR base mip; w: log2 R.
     pub light_levels: [i32; 4],
@@ -38,9 +47,30 @@ pub struct FrameUniforms {
     pub splat: [f32; 4],
 }
 
+/// `InstanceTransform` (std430): where one mesh instance is this frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct InstanceTransform {
+    pub world_from_object: [[f32; 4]; 4],
+    /// Inverse transpose of the upper 3x3, for normals.
+    pub normal_from_object: [[f32; 4]; 4],
+}
+
+impl InstanceTransform {
+    pub fn new(world_from_object: glam::Mat4) -> Self {
+        let normal = glam::Mat3::from_mat4(world_from_object)
+            .inverse()
+            .transpose();
+        Self {
+            world_from_object: world_from_object.to_cols_array_2d(),
+            normal_from_object: glam::Mat4::from_mat3(normal).to_cols_array_2d(),
+        }
+    }
+}
+
 /// `LightPatch` (std430): one patch chosen by Basic ISR.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LightPatch {
     /// xyz: mean position; w: area.
     pub position_area: [f32; 4],
@@ -70,34 +100,21 @@ pub const GEO_SPLIT: u32 = 4;
 
 /// `MaterialGpu` (std430).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MaterialGpu {
     pub base_color: [f32; 4],
     /// Texture index, -1 for none.
     pub texture: i32,
-    pub pad: [i32; 3],
+    pub pad0: i32,
+    pub pad1: i32,
+    pub pad2: i32,
 }
 
 /// `DrawPush`: push constants of one scene draw.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DrawPush {
-    pub world_from_object: [[f32; 4]; 4],
+    /// Index into the frame's `InstanceTransform` array.
+    pub instance: u32,
     pub material: u32,
-    pub pad: [u32; 3],
-}
-
-/// Views a `#[repr(C)]` plain-data value as bytes for upload.
-pub fn bytes_of<T: Copy>(value: &T) -> &[u8] {
-    // SAFETY: T is Copy plain data with no padding-dependent invariants; the
-    // GPU reads the bytes as they are.
-    unsafe { std::slice::from_raw_parts(value as *const T as *const u8, std::mem::size_of::<T>()) }
-}
-
-/// Views a slice of plain-data values as bytes for upload.
-pub fn slice_bytes<T: Copy>(values: &[T]) -> &[u8] {
-    // SAFETY: as in `bytes_of`.
-    unsafe {
-        std::slice::from_raw_parts(values.as_ptr() as *const u8, std::mem::size_of_val(values))
-    }
 }

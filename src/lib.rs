@@ -2,18 +2,24 @@
 //! with image-space hierarchies in eye space and light space (Nichols, Shopf,
 //! Wyman, EGSR 2009), and the methods it was measured against.
 //!
-//! Reading order: `renderer` (one frame), `passes` (one module per pass),
-//! `vk` (device, resources, barriers, pipelines, timing), `scene`.
+//! Reading order: `renderer` (creates, records, submits), `frame` (what every
+//! pass shares), `passes` (one module per shared pass), `methods` (one module
+//! per indirect method), `multires` (the eye-space hierarchy), `vk` (device,
+//! resources, barriers, pipelines, timing), `scene`. The README has the map.
 
 pub mod cli;
 pub mod debug_view;
+pub mod frame;
 pub mod gpu_types;
 pub mod methods;
 pub mod multires;
 pub mod output;
 pub mod passes;
 pub mod pathtrace;
+pub mod readback;
 pub mod renderer;
 pub mod report;
 pub mod scene;
+pub mod settings;
+pub mod view;
 pub mod vk;

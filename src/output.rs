@@ -1,6 +1,6 @@
 //! Writing results: a multi-layer OpenEXR of linear data and a PNG for viewing.
 
-use crate::renderer::Readback;
+use crate::readback::Readback;
 use anyhow::{anyhow, Context as _, Result};
 use exr::prelude::*;
 use std::path::Path;

@@ -1,12 +1,14 @@
 //! Per-pass GPU timings: the JSON written by `--timings` and the table the CLI prints.
 
 use crate::renderer::FrameStats;
+use anyhow::{Context as _, Result};
 use serde::Serialize;
+use std::path::Path;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct PassReport {
     pub name: String,
-    /// True for passes that exist only for indirect light (ALGORITHM.md section 6).
+    /// True for passes that exist only for indirect light (docs/algorithm.md section 6).
     pub indirect: bool,
     pub gpu_ms_median: Option<f64>,
     pub gpu_ms_min: Option<f64>,
@@ -105,6 +107,16 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         patches_per_level: stats.patches_per_level.clone(),
         light_patches: None,
     }
+}
+
+/// Writes `report` as pretty JSON to `path`, creating its folder: the one
+/// place a timings file is written (GPU methods and the path tracer alike).
+pub fn write_json(path: &Path, report: &TimingReport) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let text = serde_json::to_string_pretty(report)?;
+    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Patches per level against the area of all layers (what an unstenciled

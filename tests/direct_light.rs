@@ -1,10 +1,10 @@
-//! Direct light against ALGORITHM.md section 2, and the shadow test.
+//! Direct light against docs/algorithm.md section 2, and the shadow test.
 mod common;
 
 use common::*;
 use glam::{DVec3, Vec3, Vec4};
-use isr::renderer::RenderSettings;
 use isr::scene::Camera;
+use isr::settings::{Method, RenderSettings};
 
 #[test]
 fn plane_lit_by_spot_matches_formula_including_cone_edge() {
@@ -29,6 +29,7 @@ fn plane_lit_by_spot_matches_formula_including_cone_edge() {
         width: 256,
         height: 256,
         rsm_resolution: 1024,
+        method: Method::None,
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1).readback;
@@ -98,6 +99,7 @@ fn point_behind_occluder_is_in_shadow_and_point_beside_it_is_lit() {
         width: 256,
         height: 256,
         rsm_resolution: 512,
+        method: Method::None,
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1);

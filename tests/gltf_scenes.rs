@@ -4,8 +4,8 @@ mod common;
 
 use common::*;
 use glam::{Mat4, Vec3};
-use isr::renderer::RenderSettings;
 use isr::scene::{cornell::cornell_box, gltf_load, Scene};
+use isr::settings::{Method, RenderSettings};
 use serde_json::{json, Value};
 
 fn world_triangles(s: &Scene) -> Vec<[Vec3; 3]> {
@@ -187,6 +187,7 @@ fn base_color_texture_multiplies_the_albedo() {
         width: 128,
         height: 128,
         rsm_resolution: 64,
+        method: Method::None,
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1);

@@ -1,7 +1,9 @@
 //! Host structs (`src/gpu_types.rs`) against the layouts glslang gave the
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
-use isr::gpu_types::{DrawPush, FrameUniforms, LightPatch, MaterialGpu};
+use isr::gpu_types::{
+    DrawPush, FrameUniforms, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
+};
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
 
@@ -77,6 +79,13 @@ macro_rules! check {
                     "{}::{} vs GLSL {}.{} in {}", stringify!($ty), stringify!($field), $glsl, $member, $shader
                 );
             )*
+            // Every GLSL member is one of the host's, and none is missing: a
+            // member appended on either side fails here.
+            let mut glsl: Vec<&str> = layout.keys().map(String::as_str).collect();
+            let mut host: Vec<&str> = vec![$($member),*];
+            glsl.sort();
+            host.sort();
+            assert_eq!(glsl, host, "members of {} in {}", $glsl, $shader);
             let glsl_size = layout[stringify!($last)] as usize + $last_size;
             assert_eq!(size_of::<$ty>(), glsl_size, "size of {}", stringify!($ty));
         }
@@ -91,7 +100,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", splat: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", light_cone: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -100,6 +109,14 @@ fn frame_uniforms_match_shared_glsl() {
             light_direction => "light_direction",
             light_intensity => "light_intensity",
             light_cone => "light_cone",
+        ]);
+    }
+}
+
+#[test]
+fn run_uniforms_match_shared_glsl() {
+    for shader in ["direct_light.frag", "gather.frag", "upsample.comp"] {
+        check!(shader, RunUniforms, "RunUniforms", splat: 16, [
             shadow => "shadow",
             exposure => "exposure",
             size => "size",
@@ -110,6 +127,14 @@ fn frame_uniforms_match_shared_glsl() {
             splat => "splat",
         ]);
     }
+}
+
+#[test]
+fn instance_transform_matches_shared_glsl() {
+    check!("scene.vert", InstanceTransform, "InstanceTransform", normal_from_object: 64, [
+        world_from_object => "world_from_object",
+        normal_from_object => "normal_from_object",
+    ]);
 }
 
 #[test]
@@ -126,16 +151,17 @@ fn material_matches_shared_glsl() {
     check!("gbuffer.frag", MaterialGpu, "MaterialGpu", pad2: 4, [
         base_color => "base_color",
         texture => "texture",
-        pad => "pad0",
+        pad0 => "pad0",
+        pad1 => "pad1",
+        pad2 => "pad2",
     ]);
 }
 
 #[test]
 fn draw_push_matches_shared_glsl() {
-    check!("scene.vert", DrawPush, "DrawPush", pad2: 4, [
-        world_from_object => "world_from_object",
+    check!("scene.vert", DrawPush, "DrawPush", material: 4, [
+        instance => "instance",
         material => "material",
-        pad => "pad0",
     ]);
 }
 
@@ -197,6 +223,102 @@ fn every_shader_in_the_directory_is_embedded() {
             assert!(
                 embedded.contains(&name.as_str()),
                 "{name} was not compiled into the binary"
+            );
+        }
+    }
+}
+
+/// The descriptor bindings a pass declares on the host are checked against
+/// the shader's SPIR-V when its pipeline is made: a swapped pair of bindings
+/// of the same type, a missing or extra binding, or the wrong kind fails.
+mod bindings {
+    use isr::vk::pipeline::{check_bindings, BindingInfo};
+    use isr::vk::reflect::Kind;
+
+    fn sampled(name: &'static str) -> BindingInfo {
+        BindingInfo {
+            name,
+            kind: Kind::CombinedImageSampler,
+        }
+    }
+
+    fn frame() -> Vec<BindingInfo> {
+        let ubo = |name| BindingInfo {
+            name,
+            kind: Kind::UniformBuffer,
+        };
+        vec![
+            ubo("Frame"),
+            ubo("Run"),
+            BindingInfo {
+                name: "Transforms",
+                kind: Kind::StorageBuffer,
+            },
+        ]
+    }
+
+    const SHADERS: [&str; 2] = ["fullscreen.vert", "composite.frag"];
+
+    #[test]
+    fn the_composite_bindings_as_the_pass_makes_them_pass() {
+        let own = [
+            sampled("direct_radiance"),
+            sampled("gbuffer_albedo"),
+            sampled("indirect_irradiance"),
+        ];
+        check_bindings("composite", &SHADERS, &[&frame(), &own]).unwrap();
+    }
+
+    #[test]
+    fn swapped_bindings_of_one_type_are_rejected() {
+        let own = [
+            sampled("gbuffer_albedo"),
+            sampled("direct_radiance"),
+            sampled("indirect_irradiance"),
+        ];
+        let e = check_bindings("composite", &SHADERS, &[&frame(), &own]).unwrap_err();
+        assert!(e.to_string().contains("expects `direct_radiance`"), "{e}");
+    }
+
+    #[test]
+    fn missing_extra_and_mistyped_bindings_are_rejected() {
+        let two = [sampled("direct_radiance"), sampled("gbuffer_albedo")];
+        let e = check_bindings("composite", &SHADERS, &[&frame(), &two]).unwrap_err();
+        assert!(e.to_string().contains("does not bind"), "{e}");
+        let four = [
+            sampled("direct_radiance"),
+            sampled("gbuffer_albedo"),
+            sampled("indirect_irradiance"),
+            sampled("unused"),
+        ];
+        let e = check_bindings("composite", &SHADERS, &[&frame(), &four]).unwrap_err();
+        assert!(e.to_string().contains("none of"), "{e}");
+        let mut typed = vec![
+            sampled("direct_radiance"),
+            sampled("gbuffer_albedo"),
+            sampled("indirect_irradiance"),
+        ];
+        typed[2].kind = Kind::StorageImage;
+        let e = check_bindings("composite", &SHADERS, &[&frame(), &typed]).unwrap_err();
+        assert!(e.to_string().contains("StorageImage"), "{e}");
+        let e = check_bindings("composite", &SHADERS, &[&frame()]).unwrap_err();
+        assert!(e.to_string().contains("binds 1 set(s)"), "{e}");
+    }
+
+    #[test]
+    fn every_compiled_shader_reflects_its_bindings() {
+        // Each shader's set 0 is the frame set, named as `shaders/frame.glsl` names it.
+        let frame = frame();
+        for name in isr::vk::pipeline::shader_names() {
+            let words = isr::vk::pipeline::spirv(name).unwrap();
+            let bindings = isr::vk::reflect::bindings(&words).unwrap();
+            for b in bindings.iter().filter(|b| b.set == 0) {
+                let host = &frame[b.binding as usize];
+                assert_eq!((host.name, host.kind), (b.name.as_str(), b.kind), "{name}");
+            }
+            assert!(
+                bindings.iter().all(|b| b.set <= 1 && b.kind != Kind::Other),
+                "{name}: {bindings:?}"
             );
         }
     }

@@ -1,12 +1,12 @@
-//! Light-space hierarchies: Basic ISR and Hierarchical ISR (ALGORITHM.md
+//! Light-space hierarchies: Basic ISR and Hierarchical ISR (docs/algorithm.md
 //! sections 2 and 4).
 mod common;
 
 use common::*;
 use glam::Vec3;
 use isr::multires::MultiresSettings;
-use isr::renderer::{LightTreeSettings, Method, RenderSettings};
 use isr::scene::{cornell::cornell_box, Camera};
+use isr::settings::{LightTreeSettings, Method, RenderSettings};
 
 fn settings(method: Method, rsm: u32, light_tree: LightTreeSettings) -> RenderSettings {
     RenderSettings {

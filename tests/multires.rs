@@ -1,12 +1,12 @@
 //! The multiresolution illumination buffer and `multires-gather`
-//! (ALGORITHM.md section 3).
+//! (docs/algorithm.md section 3).
 mod common;
 
 use common::*;
 use glam::Vec3;
 use isr::multires::{MultiresSettings, Upsample};
-use isr::renderer::{Method, RenderSettings};
 use isr::scene::{cornell::cornell_box, Camera, Scene};
+use isr::settings::{Method, RenderSettings};
 
 fn settings(width: u32, height: u32, multires: MultiresSettings) -> RenderSettings {
     RenderSettings {
@@ -229,7 +229,7 @@ fn level_zero_gather_equals_the_cpu_sum() {
             .all(|&c| c == 0),
         "only level 0"
     );
-    let k = out.uniforms.hierarchy[1] as usize;
+    let k = out.run.hierarchy[1] as usize;
     assert_eq!(m.rsm_tree[k][0].len(), 256, "256 VPLs at level {k}");
     let vpls = vpls_at(m, k);
     let mut checked = 0;
@@ -263,7 +263,7 @@ fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
         &settings(128, 128, MultiresSettings::default()),
     );
     let m = &out.multires;
-    let vpls = vpls_at(m, out.uniforms.hierarchy[1] as usize);
+    let vpls = vpls_at(m, out.run.hierarchy[1] as usize);
     let w = m.width;
     let mut checked = vec![0; m.levels as usize + 1];
     for (l, count) in checked.iter_mut().enumerate() {
@@ -448,12 +448,12 @@ fn interpolated_upsampling_leaves_no_seams_on_a_flat_wall() {
 fn point_sampled_vpls_scale_flux_by_the_patch_size() {
     let gpu = gpu();
     let s = RenderSettings {
-        vpl_sampling: isr::renderer::VplSampling::Point,
+        vpl_sampling: isr::settings::VplSampling::Point,
         ..settings(64, 64, level_zero_only())
     };
     let out = render_multires(&gpu, &cornell_box(), &s);
     let m = &out.multires;
-    let k = out.uniforms.hierarchy[1] as usize;
+    let k = out.run.hierarchy[1] as usize;
     let span = 1usize << k;
     let r = m.rsm_tree[0][0].len().isqrt();
     // Centre texels of each patch, flux and area scaled by span^2.

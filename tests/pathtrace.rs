@@ -1,13 +1,13 @@
-//! The CPU path-traced one-bounce reference (ALGORITHM.md sections 1 and 5).
+//! The CPU path-traced one-bounce reference (docs/algorithm.md sections 1 and 5).
 mod common;
 
 use common::*;
 use glam::{Vec3, Vec3A};
 use isr::pathtrace::{render as trace, PathTraceSettings};
-use isr::renderer::{Method, RenderSettings};
 use isr::scene::{cornell::cornell_box, cuboid, Camera, Scene};
+use isr::settings::{Method, RenderSettings};
 
-fn pt(scene: &Scene, width: u32, height: u32, spp: u32, seed: u64) -> isr::renderer::Readback {
+fn pt(scene: &Scene, width: u32, height: u32, spp: u32, seed: u64) -> isr::readback::Readback {
     trace(
         scene,
         &PathTraceSettings {
@@ -33,6 +33,7 @@ fn direct_layer_matches_the_rasterised_direct_layer() {
             width: w,
             height: h,
             rsm_resolution: 1024,
+            method: Method::None,
             ..Default::default()
         },
         1,
@@ -66,7 +67,7 @@ fn direct_layer_matches_the_rasterised_direct_layer() {
 
 /// Root-mean-square difference of two images' indirect layers over pixels
 /// with geometry.
-fn rms_difference(a: &isr::renderer::Readback, b: &isr::renderer::Readback) -> f64 {
+fn rms_difference(a: &isr::readback::Readback, b: &isr::readback::Readback) -> f64 {
     let (mut e, mut n) = (0.0, 0);
     for i in 0..a.indirect.len() {
         if a.position[i][3] > 0.0 {
@@ -290,6 +291,7 @@ fn single_sided_occluders_shadow_alike_in_both_renderers() {
             &RenderSettings {
                 width: 64,
                 height: 64,
+                method: Method::None,
                 ..Default::default()
             },
             1,

@@ -1,10 +1,10 @@
-//! The reflective shadow map's radiometry (ALGORITHM.md section 2).
+//! The reflective shadow map's radiometry and its quadtree (docs/algorithm.md section 2).
 mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::renderer::RenderSettings;
 use isr::scene::Camera;
+use isr::settings::{Method, RenderSettings};
 use std::f64::consts::PI;
 
 /// rho * integral of I(w) over the cone, by Simpson's rule in the polar angle.
@@ -40,6 +40,7 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
         width: 64,
         height: 64,
         rsm_resolution: 256,
+        method: Method::None,
         ..Default::default()
     };
     let rsm = render(&gpu, &scene, &settings, 1).readback.rsm;
@@ -81,5 +82,150 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
     assert!(
         (area - area_expected).abs() < 0.01 * area_expected,
         "sum of A_j {area} vs {area_expected}"
+    );
+}
+
+/// One node of the RSM quadtree, reduced on the CPU in f64.
+#[derive(Clone, Copy)]
+struct Node {
+    position: glam::DVec3,
+    area: f64,
+    normal: glam::DVec3,
+    /// 0 empty, 1 valid, -1 invalid (`PATCH_*`); with `borderline` when a
+    /// threshold test was within rounding of its limit.
+    state: f32,
+    borderline: bool,
+    flux: glam::DVec4,
+}
+
+/// docs/algorithm.md section 2 ("A patch P"), computed independently of the
+/// GPU from the RSM itself: flux, solid angle and area add up, position and
+/// normal are area-weighted means, and a patch is valid when its non-empty
+/// children are valid and lie on one surface (offset from the patch's plane
+/// under `depth` times the child's distance to the light, normal within
+/// `cos_normal`).
+fn cpu_level(
+    children: &[Node],
+    side: usize,
+    light: glam::DVec3,
+    depth: f64,
+    cos_normal: f64,
+) -> Vec<Node> {
+    let half = side / 2;
+    let mut out = Vec::with_capacity(half * half);
+    for y in 0..half {
+        for x in 0..half {
+            let c: Vec<Node> = (0..4)
+                .map(|i| children[(2 * y + (i >> 1)) * side + 2 * x + (i & 1)])
+                .collect();
+            let area: f64 = c.iter().map(|n| n.area).sum();
+            let flux = c.iter().map(|n| n.flux).sum();
+            let position = if area > 0.0 {
+                c.iter().map(|n| n.position * n.area).sum::<glam::DVec3>() / area
+            } else {
+                glam::DVec3::ZERO
+            };
+            let normal = c
+                .iter()
+                .map(|n| n.normal * n.area)
+                .sum::<glam::DVec3>()
+                .normalize_or_zero();
+            let mut borderline = c.iter().any(|n| n.borderline);
+            let mut state = 0.0;
+            if area > 0.0 {
+                let mut one = c.iter().all(|n| n.state != -1.0);
+                for n in c.iter().filter(|n| n.state != 0.0) {
+                    let offset = (n.position - position).dot(normal).abs();
+                    let reach = depth * n.position.distance(light);
+                    let cos = n.normal.dot(normal);
+                    borderline |= (offset - reach).abs() < 1e-4 * reach.max(1e-6)
+                        || (cos - cos_normal).abs() < 1e-4;
+                    one &= offset < reach && cos > cos_normal;
+                }
+                state = if one { 1.0 } else { -1.0 };
+            }
+            out.push(Node {
+                position,
+                area,
+                normal,
+                state,
+                borderline,
+                flux,
+            });
+        }
+    }
+    out
+}
+
+#[test]
+fn rsm_quadtree_matches_an_independent_cpu_reduction() {
+    let gpu = gpu();
+    let scene = isr::scene::cornell::cornell_box();
+    let settings = RenderSettings {
+        width: 64,
+        height: 64,
+        rsm_resolution: 64,
+        vpls: 16,
+        method: Method::MultiresGather,
+        ..Default::default()
+    };
+    let m = render_multires(&gpu, &scene, &settings).multires;
+    let lt = &settings.light_tree;
+    let light = scene.light.position.as_dvec3();
+    let cos_normal = (lt.normal_threshold_deg as f64).to_radians().cos();
+    let v = |a: &[f32; 4]| glam::DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+    let [pos, nrm, flux] = &m.rsm_tree[0];
+    let mut level: Vec<Node> = (0..pos.len())
+        .map(|i| Node {
+            position: v(&pos[i]),
+            area: pos[i][3] as f64,
+            normal: v(&nrm[i]),
+            state: nrm[i][3],
+            borderline: false,
+            flux: glam::Vec4::from(flux[i]).as_dvec4(),
+        })
+        .collect();
+    let mut side = settings.rsm_resolution as usize;
+    let mut compared = 0;
+    let mut invalid = 0;
+    for k in 1..m.rsm_tree.len() {
+        level = cpu_level(&level, side, light, lt.depth_threshold as f64, cos_normal);
+        side /= 2;
+        let [gpos, gnrm, gflux] = &m.rsm_tree[k];
+        for (i, cpu) in level.iter().enumerate() {
+            let total = cpu.flux.max_element().max(1e-12);
+            let gf = glam::Vec4::from(gflux[i]).as_dvec4();
+            assert!(
+                (gf - cpu.flux).abs().max_element() <= 1e-4 * total,
+                "level {k} texel {i}: flux {gf:?} vs CPU {:?}",
+                cpu.flux
+            );
+            assert!(
+                (gpos[i][3] as f64 - cpu.area).abs() <= 1e-4 * cpu.area.max(1e-12),
+                "level {k} texel {i}: area"
+            );
+            if cpu.area > 0.0 {
+                assert!(
+                    v(&gpos[i]).distance(cpu.position) < 1e-4,
+                    "level {k} texel {i}: position {:?} vs CPU {:?}",
+                    v(&gpos[i]),
+                    cpu.position
+                );
+                assert!(
+                    v(&gnrm[i]).distance(cpu.normal) < 1e-3,
+                    "level {k} texel {i}: normal"
+                );
+            }
+            if !cpu.borderline {
+                assert_eq!(gnrm[i][3], cpu.state, "level {k} texel {i}: patch state");
+                compared += 1;
+                invalid += (cpu.state == -1.0) as usize;
+            }
+        }
+    }
+    // The box has edges: both outcomes of the validity test were compared.
+    assert!(
+        compared > 1000 && invalid > 10,
+        "{compared} states compared, {invalid} invalid"
     );
 }

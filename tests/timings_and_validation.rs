@@ -2,8 +2,8 @@
 mod common;
 
 use common::*;
-use isr::renderer::{Method, RenderSettings};
 use isr::scene::cornell::cornell_box;
+use isr::settings::{Method, RenderSettings};
 
 const PASSES: [&str; 5] = ["rsm", "gbuffer", "direct", "composite", "tonemap"];
 
@@ -14,6 +14,7 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
         width: 128,
         height: 128,
         rsm_resolution: 128,
+        method: Method::None,
         ..Default::default()
     };
     let out = render(&gpu, &cornell_box(), &settings, 4);
@@ -24,7 +25,8 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
         let mut sum = 0.0;
         for p in frame {
             let ms = p.gpu_ms.expect("lavapipe supports timestamps");
-            assert!(ms >= 0.0, "pass {} took {ms} ms", p.name);
+            // Every pass does work at 128x128; a zero would mean a missing timestamp.
+            assert!(ms > 0.0, "pass {} took {ms} ms", p.name);
             sum += ms;
             assert!(
                 p.fragment_invocations.is_some_and(|n| n > 0),
@@ -212,8 +214,7 @@ fn synchronization_validation_reports_a_real_hazard() {
         gpu.device.cmd_fill_buffer(cmd, buffer.buffer, 0, 256, 2);
     })
     .unwrap();
-    let mut buffer = buffer;
-    buffer.destroy(&gpu);
+    drop(buffer);
     let messages = gpu.take_validation_messages();
     assert!(
         messages.iter().any(|m| m.contains("WRITE_AFTER_WRITE")),

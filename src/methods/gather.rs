@@ -1,24 +1,25 @@
 //! Pass `gather`: stenciled gathering into the multiresolution buffer
-//! (ALGORITHM.md section 3 step 6). One instanced draw over every layer
+//! (docs/algorithm.md section 3, step 6). One instanced draw over every layer
 //! (`shaders/layered.vert` + `shaders/gather.frag`), stencil test EQUAL 1
 //! before the shader. Reads the geometry mips and the RSM quadtree (and the
 //! ISR list); writes the illumination buffer and the evaluation counts
 //! (barriers: `MultiresBuffer::fill_layers`).
 //! Which light patches each eye-space patch gathers is the method's choice
-//! ([`LightPatches`]); [`GatherMethod`] puts the method's passes in order.
+//! ([`LightPatches`]); [`MultiresMethod`] puts the passes of every method
+//! that works through the multiresolution buffer in order.
 
 use super::isr::IsrSelectPass;
-use super::multires_splat::MultiresSplatPass;
+use super::IndirectMethod;
+use crate::frame::{FrameContext, Setup};
 use crate::multires::{Multires, MultiresBuffer};
-use crate::passes::{FrameContext, INDIRECT_GRAPHICS};
-use crate::renderer::{isr_base_mip, levels_of, FrameInputs, Method, RenderSettings};
-use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, Pipeline, StencilTest};
+use crate::passes::INDIRECT_GRAPHICS;
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
+use crate::vk::Buffer;
 use anyhow::Result;
 use ash::vk;
 
-/// The light patches of ALGORITHM.md section 4 (`LIGHT_PATCHES` in the shader).
+/// The light patches of docs/algorithm.md section 4 (`LIGHT_PATCHES` in the shader).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightPatches {
     /// N regular VPLs: one level of the RSM quadtree.
@@ -29,45 +30,56 @@ pub enum LightPatches {
     Traversal = 2,
 }
 
+/// What fills the multiresolution buffer's patches: the gather or the splat.
+pub trait FillPass {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer);
+}
+
 pub struct GatherPass {
-    pipeline: Pipeline,
-    set: DescriptorSet,
+    pipeline: PassPipeline,
     stencil: bool,
+    /// Bound where there is no chosen list (the descriptor needs a buffer).
+    _placeholder: Option<Buffer>,
 }
 
 impl GatherPass {
-    /// With `stencil` false the pipeline has no stencil test (measurement
-    /// baseline). `chosen` is Basic ISR's list (any buffer for other sources).
+    /// `chosen` is Basic ISR's list (`None` for other sources). With
+    /// `--stencil off` the pipeline has no stencil test (measurement baseline).
     pub fn new(
-        gpu: &Gpu,
-        inputs: &FrameInputs,
+        setup: &Setup,
         m: &MultiresBuffer,
         source: LightPatches,
-        chosen: &Buffer,
-        stencil: bool,
+        chosen: Option<&Buffer>,
     ) -> Result<Self> {
-        let (uniforms, t, s) = (inputs.uniforms, inputs.targets, inputs.samplers);
-        let set = DescriptorSet::new(
+        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
+        let placeholder = match chosen {
+            Some(_) => None,
+            None => Some(Buffer::new(
+                gpu,
+                "no chosen patches",
+                crate::gpu_types::CHOSEN_PATCHES_HEADER as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                gpu_allocator::MemoryLocation::GpuOnly,
+            )?),
+        };
+        let chosen = chosen.or(placeholder.as_ref()).expect("one of the two");
+        let stencil = setup.settings.multires.stencil;
+        let pipeline = PassPipeline::graphics(
             gpu,
-            "gather",
+            setup.frame,
             &[
-                Binding::Uniform(uniforms),
-                Binding::Sampled(m.geo_mean.view, s.nearest),
-                Binding::Sampled(m.geo_normal.view, s.nearest),
-                Binding::Sampled(m.geo_flags.view, s.nearest),
-                Binding::Sampled(t.rsm_position.view, s.nearest),
-                Binding::Sampled(t.rsm_normal.view, s.nearest),
-                Binding::Sampled(t.rsm_flux.view, s.nearest),
-                Binding::Storage(chosen),
+                Binding::sampled("geo_mean", m.geo_mean.view, s.nearest),
+                Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
+                Binding::sampled("geo_flags", m.geo_flags.view, s.nearest),
+                Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
+                Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
+                Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
+                Binding::storage("ChosenPatches", chosen),
             ],
-        )?;
-        let pipeline = Pipeline::graphics(
-            gpu,
-            &GraphicsDesc {
+            GraphicsDesc {
                 name: "gather",
                 vertex_shader: "layered.vert",
                 fragment_shader: "gather.frag",
-                set_layouts: &[set.layout],
                 color_formats: &[m.illumination.format, m.evaluations.format],
                 stencil_format: if stencil {
                     m.stencil.format
@@ -81,129 +93,68 @@ impl GatherPass {
         )?;
         Ok(Self {
             pipeline,
-            set,
             stencil,
+            _placeholder: placeholder,
         })
     }
+}
 
-    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
+impl FillPass for GatherPass {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         profiler.pass(gpu, cmd, "gather", INDIRECT_GRAPHICS, || {
             m.fill_layers(gpu, cmd, self.stencil, || unsafe {
-                self.pipeline
-                    .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+                self.pipeline.bind(gpu, cmd, ctx.frame_set);
                 gpu.device.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
             });
         });
     }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
-    }
-}
-
-/// What fills the multiresolution buffer's patches.
-enum Fill {
-    Gather(GatherPass),
-    Splat(MultiresSplatPass),
 }
 
 /// A method that works through the multiresolution buffer: `multires-gather`,
 /// `isr`, `hisr` and `multires-splat`. Geometry mips and stencil refinement,
-/// the method's own light-space passes, the gather (or splat), then upsampling.
-pub struct GatherMethod {
+/// the method's own light-space pass (ISR's selection), the gather or splat,
+/// then upsampling.
+pub struct MultiresMethod {
     pub multires: Multires,
     /// Basic ISR's patch selection (method `isr` only).
     pub isr: Option<IsrSelectPass>,
-    fill: Fill,
-    /// Bound for methods without a chosen list (the descriptor needs a buffer).
-    placeholder: Option<Buffer>,
+    fill: Box<dyn FillPass>,
 }
 
-impl GatherMethod {
-    pub fn new(gpu: &Gpu, inputs: &FrameInputs, settings: &RenderSettings) -> Result<Self> {
-        let (uniforms, t, s) = (inputs.uniforms, inputs.targets, inputs.samplers);
-        let multires = Multires::new(gpu, uniforms, t, s, levels_of(settings))?;
-        let method = settings.method;
-        let (source, isr) = match method {
-            Method::Isr => (
-                LightPatches::ChosenList,
-                Some(IsrSelectPass::new(
-                    gpu,
-                    uniforms,
-                    t,
-                    s,
-                    isr_base_mip(settings),
-                )?),
-            ),
-            Method::Hisr => (LightPatches::Traversal, None),
-            _ => (LightPatches::Regular, None),
-        };
-        let placeholder = match &isr {
-            Some(_) => None,
-            None => Some(Buffer::new(
-                gpu,
-                "no chosen patches",
-                crate::gpu_types::CHOSEN_PATCHES_HEADER as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                gpu_allocator::MemoryLocation::GpuOnly,
-            )?),
-        };
-        let chosen = isr
-            .as_ref()
-            .map(|i| &i.chosen)
-            .or(placeholder.as_ref())
-            .unwrap();
-        let fill = if method == Method::MultiresSplat {
-            Fill::Splat(MultiresSplatPass::new(
-                gpu,
-                inputs,
-                &multires.buffer,
-                settings.vpls,
-            )?)
-        } else {
-            let stencil = settings.multires.stencil;
-            Fill::Gather(GatherPass::new(
-                gpu,
-                inputs,
-                &multires.buffer,
-                source,
-                chosen,
-                stencil,
-            )?)
-        };
+impl MultiresMethod {
+    /// `fill` makes the pass that fills the buffer's patches, given the
+    /// buffer and ISR's chosen list (if `isr` is given).
+    pub fn new(
+        setup: &Setup,
+        isr: Option<IsrSelectPass>,
+        fill: impl FnOnce(&Setup, &MultiresBuffer, Option<&Buffer>) -> Result<Box<dyn FillPass>>,
+    ) -> Result<Self> {
+        let multires = Multires::new(setup)?;
+        let fill = fill(setup, &multires.buffer, isr.as_ref().map(|i| &i.chosen))?;
         Ok(Self {
             multires,
             isr,
             fill,
-            placeholder,
         })
     }
+}
 
-    pub fn record(&self, ctx: &FrameContext, p: &mut Profiler) {
+impl IndirectMethod for MultiresMethod {
+    fn record(&self, ctx: &FrameContext, p: &mut Profiler, _: usize) {
         self.multires.record_refinement(ctx, p);
         if let Some(isr) = &self.isr {
             isr.record(ctx, p);
         }
-        match &self.fill {
-            Fill::Gather(g) => g.record(ctx, p, &self.multires.buffer),
-            Fill::Splat(s) => s.record(ctx, p, &self.multires.buffer),
-        }
+        self.fill.record(ctx, p, &self.multires.buffer);
         self.multires.record_upsample(ctx, p);
     }
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        match &mut self.fill {
-            Fill::Gather(g) => g.destroy(gpu),
-            Fill::Splat(s) => s.destroy(gpu),
-        }
-        if let Some(i) = &mut self.isr {
-            i.destroy(gpu);
-        }
-        if let Some(b) = &mut self.placeholder {
-            b.destroy(gpu);
-        }
-        self.multires.destroy(gpu);
+    fn multires(&self) -> Option<&MultiresBuffer> {
+        Some(&self.multires.buffer)
+    }
+
+    fn chosen_patches(&self) -> Option<&Buffer> {
+        self.isr.as_ref().map(|i| &i.chosen)
     }
 }

@@ -1,8 +1,24 @@
-//! Method `hisr` (Hierarchical image-space radiosity, ALGORITHM.md section 4):
-//! every eye-space patch traverses the RSM quadtree itself, subdividing light
-//! patches whose contribution could exceed tau. The traversal is in
-//! `shaders/gather.frag` (`traverse`, with the derivation of the bound); this
-//! module holds its constants.
+//! Method `hisr` (Hierarchical image-space radiosity, docs/algorithm.md
+//! section 4): every eye-space patch traverses the RSM quadtree itself,
+//! subdividing light patches whose contribution could exceed tau. The
+//! traversal is in `shaders/gather.frag` (`traverse`, with the derivation of
+//! the bound); this module makes the method and holds its constants.
+
+use super::gather::{GatherPass, LightPatches, MultiresMethod};
+use crate::frame::Setup;
+use anyhow::Result;
+
+/// Method `hisr`: the gather traverses the quadtree per fragment.
+pub fn new(setup: &Setup) -> Result<MultiresMethod> {
+    MultiresMethod::new(setup, None, |setup, m, _| {
+        Ok(Box::new(GatherPass::new(
+            setup,
+            m,
+            LightPatches::Traversal,
+            None,
+        )?))
+    })
+}
 
 /// T at the finest level for `tau` given as a fraction of the light's peak
 /// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2).

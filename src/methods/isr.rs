@@ -1,4 +1,4 @@
-//! Method `isr` (Basic image-space radiosity, ALGORITHM.md section 4): per
+//! Method `isr` (Basic image-space radiosity, docs/algorithm.md section 4): per
 //! frame, the largest valid patches of the RSM quadtree above a dense base
 //! level, compacted on the GPU into one list that every eye-space patch
 //! gathers from (`methods::gather`).
@@ -6,16 +6,30 @@
 //! Pass `isr-select`: `shaders/isr_select.comp`, one dispatch over the base
 //! level with an atomic append. Reads the RSM quadtree; writes the chosen list.
 
+use super::gather::{GatherPass, LightPatches, MultiresMethod};
+use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER};
-use crate::passes::{ComputePass, FrameContext, INDIRECT_COMPUTE};
-use crate::renderer::{Samplers, Targets};
+use crate::passes::{ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier;
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
+use crate::vk::Buffer;
 use anyhow::Result;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+
+/// Method `isr`: the selection, then every eye-space patch gathers the list.
+pub fn new(setup: &Setup) -> Result<MultiresMethod> {
+    let select = IsrSelectPass::new(setup)?;
+    MultiresMethod::new(setup, Some(select), |setup, m, chosen| {
+        Ok(Box::new(GatherPass::new(
+            setup,
+            m,
+            LightPatches::ChosenList,
+            chosen,
+        )?))
+    })
+}
 
 pub struct IsrSelectPass {
     pass: ComputePass,
@@ -25,14 +39,10 @@ pub struct IsrSelectPass {
 }
 
 impl IsrSelectPass {
-    /// `base_mip`: the RSM quadtree level to start from (also in the uniforms).
-    pub fn new(
-        gpu: &Gpu,
-        uniforms: &Buffer,
-        t: &Targets,
-        s: &Samplers,
-        base_mip: u32,
-    ) -> Result<Self> {
+    pub fn new(setup: &Setup) -> Result<Self> {
+        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
+        // The RSM quadtree level to start from (also in the run uniforms).
+        let base_mip = setup.settings.isr_base_mip();
         // At most one chosen patch per base texel.
         let base_extent = t.rsm_position.mip_extent(base_mip);
         let base_texels = base_extent.width as u64 * base_extent.height as u64;
@@ -46,13 +56,12 @@ impl IsrSelectPass {
             MemoryLocation::GpuOnly,
         )?;
         let bindings = vec![
-            Binding::Uniform(uniforms),
-            Binding::Sampled(t.rsm_position.view, s.nearest),
-            Binding::Sampled(t.rsm_normal.view, s.nearest),
-            Binding::Sampled(t.rsm_flux.view, s.nearest),
-            Binding::Storage(&chosen),
+            Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
+            Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
+            Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
+            Binding::storage("ChosenPatches", &chosen),
         ];
-        let pass = ComputePass::new(gpu, "isr-select", "isr_select.comp", &[bindings], 0, &[])?;
+        let pass = ComputePass::new(setup, "isr-select", "isr_select.comp", &[bindings], 0, &[])?;
         Ok(Self {
             pass,
             chosen,
@@ -83,7 +92,7 @@ impl IsrSelectPass {
                 rw,
             );
             // One invocation per base texel.
-            self.pass.dispatch(gpu, cmd, 0, &[], self.base_extent);
+            self.pass.dispatch(ctx, 0, &[], self.base_extent);
             barrier::memory(
                 gpu,
                 cmd,
@@ -93,10 +102,5 @@ impl IsrSelectPass {
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
             );
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pass.destroy(gpu);
-        self.chosen.destroy(gpu);
     }
 }

@@ -1,38 +1,76 @@
-//! Indirect-light methods, one module each (ALGORITHM.md sections 4 and 5).
-//! Each writes the full-resolution indirect irradiance image: either through
-//! the multiresolution buffer ([`gather::GatherMethod`]) or directly at full
-//! resolution ([`FullResolution`]).
+//! Indirect-light methods, one module each (docs/algorithm.md sections 4 and
+//! 5), behind one interface, [`IndirectMethod`]: each writes the
+//! full-resolution indirect irradiance image `Targets::indirect`, either
+//! through the multiresolution buffer ([`gather::MultiresMethod`]) or directly
+//! at full resolution.
+//!
+//! Adding a method: its module here (and its shaders), a variant of
+//! `settings::Method` (its doc comment is the CLI help), and one arm in
+//! [`create`].
 
 pub mod gather;
 pub mod hisr;
 pub mod isr;
+pub mod multires_gather;
 pub mod multires_splat;
+pub mod none;
 pub mod reference;
 pub mod rsm_gather;
 pub mod rsm_splat;
 
-use crate::passes::FrameContext;
+use crate::frame::{FrameContext, Setup};
+use crate::multires::MultiresBuffer;
+use crate::settings::Method;
 use crate::vk::profiler::Profiler;
-use crate::vk::Gpu;
+use crate::vk::Buffer;
+use anyhow::{bail, Result};
 
-/// Methods that compute every pixel at full resolution.
-pub enum FullResolution {
-    Gather(rsm_gather::RsmGatherPass),
-    Splat(rsm_splat::RsmSplatPass),
+/// One way of computing indirect light. Made once per run (`create`); records
+/// its passes into every frame after the RSM, G-buffer, direct light and (if
+/// it reads it) the RSM quadtree, and before the composite. Its GPU objects
+/// free themselves when it is dropped.
+pub trait IndirectMethod {
+    /// Command buffers one frame of the method takes: the reference splits its
+    /// work so that no submission runs long enough to trip a driver timeout.
+    fn submissions(&self) -> usize {
+        1
+    }
+
+    /// Records submission `submission` (of `submissions()`) into `ctx.cmd`.
+    /// After the last one, `indirect` is written and in the `READ_ONLY` state.
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, submission: usize);
+
+    /// Whether the frame must build the RSM quadtree (`passes::rsm_tree`) first.
+    fn reads_rsm_tree(&self) -> bool {
+        true
+    }
+
+    /// The multiresolution buffer, for the methods that fill one.
+    fn multires(&self) -> Option<&MultiresBuffer> {
+        None
+    }
+
+    /// Basic ISR's list of chosen light patches (`CHOSEN_PATCHES_HEADER`, then
+    /// `LightPatch`es).
+    fn chosen_patches(&self) -> Option<&Buffer> {
+        None
+    }
 }
 
-impl FullResolution {
-    pub fn record(&self, ctx: &FrameContext, p: &mut Profiler) {
-        match self {
-            Self::Gather(g) => g.record(ctx, p),
-            Self::Splat(s) => s.record(ctx, p),
-        }
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        match self {
-            Self::Gather(g) => g.destroy(gpu),
-            Self::Splat(s) => s.destroy(gpu),
-        }
-    }
+/// The method `setup.settings.method` names, made for `setup`.
+pub fn create(setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+    Ok(match setup.settings.method {
+        Method::None => Box::new(none::NoIndirect::new(setup)?),
+        Method::MultiresGather => Box::new(multires_gather::new(setup)?),
+        Method::Isr => Box::new(isr::new(setup)?),
+        Method::Hisr => Box::new(hisr::new(setup)?),
+        Method::RsmGather => Box::new(rsm_gather::RsmGather::new(setup)?),
+        Method::RsmSplat => Box::new(rsm_splat::RsmSplat::new(setup, false)?),
+        Method::RsmSplatRestricted => Box::new(rsm_splat::RsmSplat::new(setup, true)?),
+        Method::MultiresSplat => Box::new(multires_splat::new(setup)?),
+        Method::Reference => Box::new(reference::Reference::new(setup)?),
+        Method::Pathtrace => bail!(
+            "method pathtrace runs on the CPU (isr::pathtrace::render), not in the Vulkan renderer"
+        ),
+    })
 }

@@ -1,7 +1,7 @@
-//! Method `reference` (ALGORITHM.md section 5): every pixel gathers every RSM
+//! Method `reference` (docs/algorithm.md section 5): every pixel gathers every RSM
 //! texel (N = R^2 VPLs) at full resolution, the converged limit of the
 //! approximation. The work is split into bands of VPLs, one submission each
-//! (`Renderer` starts a new command buffer per chunk), so no submission runs
+//! (`IndirectMethod::submissions`; the renderer starts a new command buffer per chunk), so no submission runs
 //! long enough to trip a driver's timeout; each band adds into `indirect`.
 //! Pass `reference` (once per chunk; the report sums them). Its time runs from
 //! the previous chunk's end-of-pass timestamp, in the previous submission, so
@@ -17,68 +17,61 @@
 
 use super::rsm_gather::full_resolution_bindings;
 use super::rsm_splat::require_blending;
-use crate::passes::{begin_rendering, Attachments, FrameContext, INDIRECT_GRAPHICS};
-use crate::renderer::FrameInputs;
+use super::IndirectMethod;
+use crate::frame::{FrameContext, Setup};
+use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Blend, DescriptorSet, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
-use crate::vk::Gpu;
 use anyhow::Result;
 use ash::vk;
 
-pub struct ReferencePass {
-    pipeline: Pipeline,
-    set: DescriptorSet,
+pub struct Reference {
+    pipeline: PassPipeline,
     /// VPL ranges [first, last) in row-major RSM order, one per submission.
     pub chunks: Vec<(u32, u32)>,
 }
 
-impl ReferencePass {
-    /// `per_submission`: light-patch evaluations one submission may do.
-    pub fn new(
-        gpu: &Gpu,
-        inputs: &FrameInputs,
-        width: u32,
-        height: u32,
-        rsm: u32,
-        per_submission: u64,
-    ) -> Result<Self> {
-        let format = inputs.targets.indirect.format;
-        require_blending(gpu, format, "reference")?;
-        let set = DescriptorSet::new(gpu, "reference", &full_resolution_bindings(inputs))?;
-        let pipeline = Pipeline::graphics(
-            gpu,
-            &GraphicsDesc {
+impl Reference {
+    /// Chunks of at most `settings.reference_chunk` light-patch evaluations
+    /// (pixels x VPLs) each.
+    pub fn new(setup: &Setup) -> Result<Self> {
+        let s = setup.settings;
+        let format = setup.targets.indirect.format;
+        require_blending(setup.gpu, format, "reference")?;
+        let pipeline = PassPipeline::graphics(
+            setup.gpu,
+            setup.frame,
+            &full_resolution_bindings(setup),
+            GraphicsDesc {
                 name: "reference",
                 fragment_shader: "rsm_gather.frag",
-                set_layouts: &[set.layout],
                 push_constant_bytes: 8,
                 color_formats: &[format],
                 blend: Blend::Additive,
                 ..Default::default()
             },
         )?;
-        let total = rsm * rsm;
-        let per_chunk =
-            (per_submission / (width as u64 * height as u64)).clamp(1, total as u64) as u32;
+        let total = s.rsm_resolution * s.rsm_resolution;
+        let pixels = s.width as u64 * s.height as u64;
+        let per_chunk = (s.reference_chunk.max(1) / pixels).clamp(1, total as u64) as u32;
         let chunks = (0..total.div_ceil(per_chunk))
             .map(|c| (c * per_chunk, ((c + 1) * per_chunk).min(total)))
             .collect();
-        Ok(Self {
-            pipeline,
-            set,
-            chunks,
-        })
+        Ok(Self { pipeline, chunks })
+    }
+}
+
+impl IndirectMethod for Reference {
+    fn submissions(&self) -> usize {
+        self.chunks.len()
     }
 
     /// Records chunk `i` into `ctx.cmd` (its own command buffer).
-    pub fn record_chunk(&self, ctx: &FrameContext, profiler: &mut Profiler, i: usize) {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, i: usize) {
         let (gpu, cmd, indirect) = (ctx.gpu, ctx.cmd, &ctx.targets.indirect);
         let (first, last) = self.chunks[i];
-        let push: Vec<u8> = [first as i32, last as i32]
-            .iter()
-            .flat_map(|v| v.to_ne_bytes())
-            .collect();
+        let push = push_bytes(&[first as i32, last as i32]);
         profiler.pass(gpu, cmd, "reference", INDIRECT_GRAPHICS, || unsafe {
             if i == 0 {
                 // Cleared once; every chunk then adds its band of VPLs.
@@ -93,20 +86,18 @@ impl ReferencePass {
                     Use::COLOR_ATTACHMENT,
                 );
             }
-            let colors = [indirect.view];
             begin_rendering(
                 gpu,
                 cmd,
                 &Attachments {
                     clear_colors: false,
-                    ..Attachments::simple(&colors, None, indirect.extent)
+                    ..Attachments::simple(&[indirect.view], None, indirect.extent)
                 },
             );
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+            self.pipeline.bind(gpu, cmd, ctx.frame_set);
             gpu.device.cmd_push_constants(
                 cmd,
-                self.pipeline.layout,
+                self.pipeline.pipeline.layout,
                 vk::ShaderStageFlags::ALL_GRAPHICS,
                 0,
                 &push,
@@ -117,10 +108,5 @@ impl ReferencePass {
                 barrier::transition(gpu, cmd, &[indirect], Use::COLOR_ATTACHMENT, Use::READ_ONLY);
             }
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
     }
 }

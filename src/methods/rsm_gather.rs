@@ -1,56 +1,48 @@
-//! Method `rsm-gather` (ALGORITHM.md section 5, Dachsbacher & Stamminger
+//! Method `rsm-gather` (docs/algorithm.md section 5, Dachsbacher & Stamminger
 //! 2005): every full-resolution pixel gathers the N regular VPLs. Pass
 //! `rsm-gather`, `shaders/rsm_gather.frag` (barriers: `FullscreenPass::record`).
 //! Reads the G-buffer and the RSM quadtree; writes `indirect`.
 
-use crate::passes::{FrameContext, FullscreenPass, INDIRECT_GRAPHICS};
-use crate::renderer::FrameInputs;
+use super::IndirectMethod;
+use crate::frame::{FrameContext, Setup};
+use crate::passes::{push_bytes, FullscreenPass, INDIRECT_GRAPHICS};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::Gpu;
 use anyhow::Result;
 
-/// The bindings `rsm_gather.frag` and the splat shaders share: frame uniforms,
-/// G-buffer position and normal, RSM quadtree position, normal and flux.
-pub fn full_resolution_bindings<'a>(inputs: &'a FrameInputs) -> Vec<Binding<'a>> {
-    let (t, s) = (inputs.targets, inputs.samplers);
+/// The bindings `rsm_gather.frag` and the splat shaders share: G-buffer
+/// position and normal, RSM quadtree position, normal and flux.
+pub fn full_resolution_bindings<'a>(setup: &Setup<'a>) -> Vec<Binding<'a>> {
+    let (t, s) = (setup.targets, setup.samplers);
     vec![
-        Binding::Uniform(inputs.uniforms),
-        Binding::Sampled(t.gbuffer_position.view, s.nearest),
-        Binding::Sampled(t.gbuffer_normal.view, s.nearest),
-        Binding::Sampled(t.rsm_position.view, s.nearest),
-        Binding::Sampled(t.rsm_normal.view, s.nearest),
-        Binding::Sampled(t.rsm_flux.view, s.nearest),
+        Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+        Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+        Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
+        Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
+        Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
     ]
 }
 
-pub struct RsmGatherPass(FullscreenPass);
+pub struct RsmGather(FullscreenPass);
 
-impl RsmGatherPass {
-    pub fn new(gpu: &Gpu, inputs: &FrameInputs) -> Result<Self> {
-        Ok(Self(FullscreenPass::with_push_constants(
-            gpu,
+impl RsmGather {
+    pub fn new(setup: &Setup) -> Result<Self> {
+        Ok(Self(FullscreenPass::new(
+            setup,
             "rsm-gather",
+            INDIRECT_GRAPHICS,
             "rsm_gather.frag",
-            &full_resolution_bindings(inputs),
-            &[inputs.targets.indirect.format],
+            &full_resolution_bindings(setup),
             8,
+            |t| &t.indirect,
         )?))
     }
+}
 
-    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+impl IndirectMethod for RsmGather {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, _: usize) {
         // All VPLs: first 0, last past the end.
-        let push: Vec<u8> = [0i32, i32::MAX]
-            .iter()
-            .flat_map(|v| v.to_ne_bytes())
-            .collect();
-        profiler.pass(ctx.gpu, ctx.cmd, "rsm-gather", INDIRECT_GRAPHICS, || {
-            self.0
-                .record_with(ctx.gpu, ctx.cmd, &[&ctx.targets.indirect], &push)
-        });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
+        self.0
+            .record_with(ctx, profiler, &push_bytes(&[0, i32::MAX]));
     }
 }

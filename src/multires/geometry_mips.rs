@@ -1,47 +1,51 @@
-//! Pass `geometry-mips`: levels 0..=L of the geometry mipmaps (ALGORITHM.md
+//! Pass `geometry-mips`: levels 0..=L of the geometry mipmaps (docs/algorithm.md
 //! section 3, steps 2-4) with `shaders/geometry_mips.comp`, one dispatch per
 //! level. Reads the G-buffer; writes `geo_*` (barriers below).
 
 use super::MultiresBuffer;
-use crate::passes::{ComputePass, FrameContext, INDIRECT_COMPUTE};
-use crate::renderer::{Samplers, Targets};
+use crate::frame::{FrameContext, Setup};
+use crate::passes::{ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
 use anyhow::Result;
 
 pub struct GeometryMipsPass(ComputePass);
 
+/// Shader names of the five chains' source (`src_*`) and destination (`dst_*`)
+/// bindings, in `MultiresBuffer::geometry_images` order.
+const SOURCES: [&str; 5] = ["src_mean", "src_normal", "src_min", "src_max", "src_flags"];
+const DESTINATIONS: [&str; 5] = ["dst_mean", "dst_normal", "dst_min", "dst_max", "dst_flags"];
+
 impl GeometryMipsPass {
-    pub fn new(
-        gpu: &Gpu,
-        uniforms: &Buffer,
-        t: &Targets,
-        s: &Samplers,
-        m: &MultiresBuffer,
-    ) -> Result<Self> {
+    pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
+        let (t, s) = (setup.targets, setup.samplers);
         let images = m.geometry_images();
         let variants: Vec<Vec<Binding>> = (0..=m.levels as usize)
             .map(|l| {
                 let mut b = vec![
-                    Binding::Uniform(uniforms),
-                    Binding::Sampled(t.gbuffer_position.view, s.nearest),
-                    Binding::Sampled(t.gbuffer_normal.view, s.nearest),
+                    Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                    Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
                 ];
                 // Level 0 has no source level; its source bindings are unused.
                 let src = l.saturating_sub(1);
                 b.extend(
                     images
                         .iter()
-                        .map(|i| Binding::StorageImage(i.mip_views[src])),
+                        .zip(SOURCES)
+                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[src])),
                 );
-                b.extend(images.iter().map(|i| Binding::StorageImage(i.mip_views[l])));
+                b.extend(
+                    images
+                        .iter()
+                        .zip(DESTINATIONS)
+                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[l])),
+                );
                 b
             })
             .collect();
         Ok(Self(ComputePass::new(
-            gpu,
+            setup,
             "geometry-mips",
             "geometry_mips.comp",
             &variants,
@@ -66,19 +70,10 @@ impl GeometryMipsPass {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 let push = (level as i32).to_ne_bytes();
-                self.0.dispatch(
-                    gpu,
-                    cmd,
-                    level as usize,
-                    &push,
-                    m.geo_flags.mip_extent(level),
-                );
+                self.0
+                    .dispatch(ctx, level as usize, &push, m.geo_flags.mip_extent(level));
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
     }
 }

@@ -1,4 +1,4 @@
-//! The eye-space hierarchy of ALGORITHM.md section 3: geometry mipmaps, the
+//! The eye-space hierarchy of docs/algorithm.md section 3: geometry mipmaps, the
 //! layered multiresolution illumination buffer with its layered stencil, the
 //! one-pass stenciled refinement and the upsampling. The methods that gather or
 //! splat into the buffer live in `methods/`.
@@ -7,56 +7,14 @@ pub mod geometry_mips;
 pub mod stencil_refine;
 pub mod upsample;
 
+use crate::frame::{FrameContext, Setup};
+use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu, Image, ImageDesc};
 use anyhow::{anyhow, bail, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Upsample {
-    /// Bilinear between neighbouring patches, renormalised, never across a discontinuity.
-    Interpolated,
-    /// Each pixel takes the value of the patch that covers it.
-    Nearest,
-}
-
-#[derive(Clone, Debug)]
-pub struct MultiresSettings {
-    /// Coarsest level L (level l texels cover 2^l x 2^l pixels); `None` picks
-    /// one from the resolution (`default_levels`).
-    pub levels: Option<u32>,
-    /// A texel is smooth when its view-depth range, relative to its nearest
-    /// depth, is below this: `(max - min) / min < t`.
-    pub depth_threshold: f32,
-    /// ... and when the normals in it span less than this angle (degrees),
-    /// measured as the diagonal of their component-wise bounding box.
-    pub normal_threshold_deg: f32,
-    pub upsample: Upsample,
-    /// Early stencil rejection in the gather (`false`: shade every texel of
-    /// every layer and mask afterwards, for measuring what the stencil saves).
-    pub stencil: bool,
-}
-
-impl Default for MultiresSettings {
-    fn default() -> Self {
-        Self {
-            levels: None,
-            depth_threshold: 0.1,
-            normal_threshold_deg: 20.0,
-            upsample: Upsample::Interpolated,
-            stencil: true,
-        }
-    }
-}
-
-/// Coarsest level for a resolution: texels of level L are about 1/16 of the
-/// shorter side (L = 5 at 512, 6 at 1024), at most 8.
-pub fn default_levels(width: u32, height: u32) -> u32 {
-    (width.min(height).max(2).ilog2().saturating_sub(4)).clamp(1, 8)
-}
-
-/// The largest number of levels the patch-count buffer holds.
-pub const MAX_LEVELS: u32 = 16;
+pub use crate::settings::{default_levels, MultiresSettings, Upsample, MAX_LEVELS};
 
 /// The images of the hierarchy. Geometry mips are mip chains of W x H images
 /// (mip l is (W >> l) x (H >> l)); the illumination buffer and its stencil are
@@ -181,12 +139,12 @@ impl MultiresBuffer {
         })
     }
 
-    /// Patches per level of the last frame (read after its fence).
+    /// Patches per level of the last frame (read once the device is idle: every
+    /// frame in flight writes this one buffer).
     pub fn patch_counts(&self) -> Vec<u32> {
-        self.patch_counts.mapped()[..4 * (self.levels as usize + 1)]
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
-            .collect()
+        let mut counts: Vec<u32> = self.patch_counts.read_pod();
+        counts.truncate(self.levels as usize + 1);
+        counts
     }
 
     /// Texels in the used corners of all layers: what a gather without the
@@ -249,22 +207,6 @@ impl MultiresBuffer {
             &self.geo_flags,
         ]
     }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        for i in [
-            &mut self.geo_mean,
-            &mut self.geo_normal,
-            &mut self.geo_min,
-            &mut self.geo_max,
-            &mut self.geo_flags,
-            &mut self.illumination,
-            &mut self.evaluations,
-            &mut self.stencil,
-        ] {
-            i.destroy(gpu);
-        }
-        self.patch_counts.destroy(gpu);
-    }
 }
 
 /// The hierarchy's passes around a method's gather or splat: geometry mips and
@@ -277,53 +219,25 @@ pub struct Multires {
 }
 
 impl Multires {
-    pub fn new(
-        gpu: &Gpu,
-        uniforms: &Buffer,
-        targets: &crate::renderer::Targets,
-        samplers: &crate::renderer::Samplers,
-        levels: u32,
-    ) -> Result<Self> {
-        let e = targets.gbuffer_position.extent;
-        let buffer = MultiresBuffer::new(gpu, e.width, e.height, levels)?;
+    pub fn new(setup: &Setup) -> Result<Self> {
+        let e = setup.targets.gbuffer_position.extent;
+        let buffer = MultiresBuffer::new(setup.gpu, e.width, e.height, setup.settings.levels())?;
         Ok(Self {
-            geometry_mips: geometry_mips::GeometryMipsPass::new(
-                gpu, uniforms, targets, samplers, &buffer,
-            )?,
-            stencil_refine: stencil_refine::StencilRefinePass::new(
-                gpu,
-                uniforms,
-                samplers.nearest,
-                &buffer,
-            )?,
-            upsample: upsample::UpsamplePass::new(gpu, uniforms, targets, samplers, &buffer)?,
+            geometry_mips: geometry_mips::GeometryMipsPass::new(setup, &buffer)?,
+            stencil_refine: stencil_refine::StencilRefinePass::new(setup, &buffer)?,
+            upsample: upsample::UpsamplePass::new(setup, &buffer)?,
             buffer,
         })
     }
 
     /// Geometry mips, then the stencil of patches.
-    pub fn record_refinement(
-        &self,
-        ctx: &crate::passes::FrameContext,
-        p: &mut crate::vk::profiler::Profiler,
-    ) {
+    pub fn record_refinement(&self, ctx: &FrameContext, p: &mut Profiler) {
         self.geometry_mips.record(ctx, p, &self.buffer);
         self.stencil_refine.record(ctx, p, &self.buffer);
     }
 
     /// The illumination buffer to the full-resolution `indirect` image.
-    pub fn record_upsample(
-        &self,
-        ctx: &crate::passes::FrameContext,
-        p: &mut crate::vk::profiler::Profiler,
-    ) {
+    pub fn record_upsample(&self, ctx: &FrameContext, p: &mut Profiler) {
         self.upsample.record(ctx, p, &self.buffer);
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.geometry_mips.destroy(gpu);
-        self.stencil_refine.destroy(gpu);
-        self.upsample.destroy(gpu);
-        self.buffer.destroy(gpu);
     }
 }

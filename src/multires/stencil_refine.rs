@@ -1,54 +1,39 @@
-//! Pass `stencil-refine`: the one-pass stenciled refinement (ALGORITHM.md
+//! Pass `stencil-refine`: the one-pass stenciled refinement (docs/algorithm.md
 //! section 3, step 4). One instanced draw covers every layer of the stencil
 //! (`shaders/layered.vert` picks the layer); `shaders/stencil_refine.frag`
 //! discards texels that are not patches and the stencil op writes 1 for the
 //! rest. Reads `geo_flags`; writes the layered stencil and the patch counts.
 
 use super::MultiresBuffer;
-use crate::passes::{
-    begin_rendering, Attachments, FrameContext, StencilAttachment, INDIRECT_GRAPHICS,
-};
+use crate::frame::{FrameContext, Setup};
+use crate::passes::{begin_rendering, Attachments, StencilAttachment, INDIRECT_GRAPHICS};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, Pipeline, StencilTest};
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
 use anyhow::Result;
 use ash::vk;
 
-pub struct StencilRefinePass {
-    pipeline: Pipeline,
-    set: DescriptorSet,
-}
+pub struct StencilRefinePass(PassPipeline);
 
 impl StencilRefinePass {
-    pub fn new(
-        gpu: &Gpu,
-        uniforms: &Buffer,
-        nearest: vk::Sampler,
-        m: &MultiresBuffer,
-    ) -> Result<Self> {
-        let set = DescriptorSet::new(
-            gpu,
-            "stencil-refine",
-            &[
-                Binding::Uniform(uniforms),
-                Binding::Sampled(m.geo_flags.view, nearest),
-                Binding::Storage(&m.patch_counts),
-            ],
-        )?;
-        let pipeline = Pipeline::graphics(
-            gpu,
-            &GraphicsDesc {
+    pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
+        let bindings = [
+            Binding::sampled("geo_flags", m.geo_flags.view, setup.samplers.nearest),
+            Binding::storage("PatchCounts", &m.patch_counts),
+        ];
+        Ok(Self(PassPipeline::graphics(
+            setup.gpu,
+            setup.frame,
+            &bindings,
+            GraphicsDesc {
                 name: "stencil-refine",
                 vertex_shader: "layered.vert",
                 fragment_shader: "stencil_refine.frag",
-                set_layouts: &[set.layout],
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::WRITE_ONE),
                 ..Default::default()
             },
-        )?;
-        Ok(Self { pipeline, set })
+        )?))
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -96,8 +81,7 @@ impl StencilRefinePass {
                     }),
                 },
             );
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
+            self.0.bind(gpu, cmd, ctx.frame_set);
             d.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
             d.cmd_end_rendering(cmd);
             barrier::transition(
@@ -116,10 +100,5 @@ impl StencilRefinePass {
                 vk::AccessFlags2::HOST_READ,
             );
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
     }
 }

@@ -1,37 +1,30 @@
 //! Pass `upsample`: the illumination buffer to a full-resolution indirect image
-//! (ALGORITHM.md section 3, step 7), `shaders/upsample.comp`: a pull from
+//! (docs/algorithm.md section 3, step 7), `shaders/upsample.comp`: a pull from
 //! level 1 up to L, then a push from L - 1 down to 0, which writes `indirect`
 //! (nearest or interpolated, by a flag in the frame uniforms).
 //! Reads the illumination buffer and geometry mips; writes `indirect`.
 
 use super::MultiresBuffer;
-use crate::passes::{ComputePass, FrameContext, INDIRECT_COMPUTE};
-use crate::renderer::{Samplers, Targets};
+use crate::frame::{FrameContext, Setup};
+use crate::passes::{push_bytes, ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
 use anyhow::Result;
 
 pub struct UpsamplePass(ComputePass);
 
 impl UpsamplePass {
-    pub fn new(
-        gpu: &Gpu,
-        uniforms: &Buffer,
-        t: &Targets,
-        s: &Samplers,
-        m: &MultiresBuffer,
-    ) -> Result<Self> {
+    pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
+        let (t, s) = (setup.targets, setup.samplers);
         let bindings = vec![
-            Binding::Uniform(uniforms),
-            Binding::StorageImage(m.illumination.view),
-            Binding::Sampled(m.geo_mean.view, s.nearest),
-            Binding::Sampled(m.geo_normal.view, s.nearest),
-            Binding::StorageImage(t.indirect.view),
+            Binding::storage_image("illumination", m.illumination.view),
+            Binding::sampled("geo_mean", m.geo_mean.view, s.nearest),
+            Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
+            Binding::storage_image("indirect", t.indirect.view),
         ];
         Ok(Self(ComputePass::new(
-            gpu,
+            setup,
             "upsample",
             "upsample.comp",
             &[bindings],
@@ -61,12 +54,9 @@ impl UpsamplePass {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 first = false;
-                let push: Vec<u8> = [level as i32, pull as i32]
-                    .iter()
-                    .flat_map(|v| v.to_ne_bytes())
-                    .collect();
+                let push = push_bytes(&[level as i32, pull as i32]);
                 self.0
-                    .dispatch(gpu, cmd, 0, &push, m.geo_flags.mip_extent(level));
+                    .dispatch(ctx, 0, &push, m.geo_flags.mip_extent(level));
             };
             for level in 1..=m.levels {
                 run(level, true);
@@ -82,9 +72,5 @@ impl UpsamplePass {
                 Use::READ_ONLY,
             );
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
     }
 }

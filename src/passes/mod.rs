@@ -1,16 +1,21 @@
-//! The passes of one frame, one module each. Every pass records, in one place,
-//! its timing scope, its barriers and its draws:
+//! The passes of one frame that every method shares, one module each, and the
+//! pass types they are made of. Every pass records, in one place, its timing
+//! scope, its barriers and its draws:
 //!
-//! 1. [`rsm`]: reflective shadow map from the spot light.
-//! 2. [`gbuffer`]: depth, position, normal, albedo from the camera.
-//! 3. [`direct_light`]: direct radiance, RSM depth as the shadow map.
-//! 4. (indirect methods, later issues: they write `Targets::indirect`)
-//! 5. [`composite`]: direct + albedo/pi * indirect irradiance.
-//! 6. [`tonemap`]: sRGB display image for the PNG.
+//! 1. [`rsm`]: reflective shadow map from the spot light ([`ScenePass`]).
+//! 2. [`gbuffer`]: depth, position, normal, albedo from the camera ([`ScenePass`]).
+//! 3. [`direct_light`]: direct radiance, RSM depth as the shadow map ([`FullscreenPass`]).
+//! 4. [`rsm_tree`]: the RSM quadtree, for the methods that read it.
+//! 5. the method (`methods`): writes `Targets::indirect`.
+//! 6. [`composite`]: direct + albedo/pi * indirect irradiance ([`FullscreenPass`]).
+//! 7. [`tonemap`]: sRGB display image for the PNG ([`FullscreenPass`]).
 //!
 //! Barrier convention (see `vk::barrier`): a pass transitions its outputs from
 //! "discard, after earlier readers" to attachment use, and at its end leaves
 //! them in `SHADER_READ_ONLY_OPTIMAL`, visible to every later reader.
+//!
+//! Every pipeline's set 0 is the frame set (`frame::FrameSet`); a pass's own
+//! inputs are set 1.
 
 pub mod composite;
 pub mod direct_light;
@@ -19,11 +24,10 @@ pub mod rsm;
 pub mod rsm_tree;
 pub mod tonemap;
 
-use crate::gpu_types::{bytes_of, DrawPush};
-use crate::renderer::SceneGpu;
+use crate::frame::{FrameContext, Setup, Targets};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, Pipeline};
-use crate::vk::profiler::PassKind;
+use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, PassPipeline, Pipeline};
+use crate::vk::profiler::{PassKind, Profiler};
 use crate::vk::{Gpu, Image};
 use anyhow::Result;
 use ash::vk;
@@ -31,6 +35,16 @@ use ash::vk;
 pub const GRAPHICS: PassKind = PassKind {
     graphics: true,
     indirect: false,
+};
+
+/// Timing kind of passes that exist only for indirect light.
+pub const INDIRECT_GRAPHICS: PassKind = PassKind {
+    graphics: true,
+    indirect: true,
+};
+pub const INDIRECT_COMPUTE: PassKind = PassKind {
+    graphics: false,
+    indirect: true,
 };
 
 /// What a render-pass instance draws into. Colors are cleared to zero, depth
@@ -151,212 +165,212 @@ pub fn begin_rendering(gpu: &Gpu, cmd: vk::CommandBuffer, a: &Attachments) {
     }
 }
 
+/// The images a scene pass writes: colors and depth.
+pub type SceneOutputs = for<'t> fn(&'t Targets) -> ([&'t Image; 3], &'t Image);
+
 /// A pass that rasterizes the scene's meshes (RSM and G-buffer): color targets
-/// plus a reversed-Z depth buffer, one draw per mesh instance.
+/// plus a reversed-Z depth buffer, one draw per mesh instance, placed by the
+/// frame's instance transforms. Set 1 is the scene's (materials, textures).
 pub struct ScenePass {
+    name: &'static str,
     pipeline: Pipeline,
+    outputs: SceneOutputs,
 }
 
 impl ScenePass {
+    /// `from_light`: rasterize from the light (RSM) rather than the camera.
     pub fn new(
-        gpu: &Gpu,
-        name: &str,
+        setup: &Setup,
+        name: &'static str,
         fragment_shader: &str,
-        scene: &SceneGpu,
-        color_formats: &[vk::Format],
         from_light: bool,
+        outputs: SceneOutputs,
     ) -> Result<Self> {
+        let (colors, depth) = outputs(setup.targets);
+        let color_formats = colors.map(|c| c.format);
         let pipeline = Pipeline::graphics(
-            gpu,
+            setup.gpu,
             &GraphicsDesc {
                 name,
                 vertex_shader: "scene.vert",
                 fragment_shader,
-                set_layouts: &[scene.set.layout],
-                push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+                sets: &[setup.frame, &setup.scene.set],
+                push_constant_bytes: std::mem::size_of::<crate::gpu_types::DrawPush>() as u32,
                 scene_vertices: true,
-                color_formats,
-                depth_format: vk::Format::D32_SFLOAT,
+                color_formats: &color_formats,
+                depth_format: depth.format,
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
-                specialization: &[(0, scene.texture_count() as i32), (1, from_light as i32)],
+                specialization: &[
+                    (0, setup.scene.texture_count() as i32),
+                    (1, from_light as i32),
+                ],
                 ..Default::default()
             },
         )?;
-        Ok(Self { pipeline })
+        Ok(Self {
+            name,
+            pipeline,
+            outputs,
+        })
     }
 
-    /// Clears and fills `colors` and `depth` with the scene, with the barriers
-    /// of the convention above on both sides.
-    pub fn record(
-        &self,
-        gpu: &Gpu,
-        cmd: vk::CommandBuffer,
-        scene: &SceneGpu,
-        colors: &[&Image],
-        depth: &Image,
-    ) {
-        let mut before: Vec<_> = colors
-            .iter()
-            .map(|c| barrier::image(c, Use::DISCARD_AFTER_READERS, Use::COLOR_ATTACHMENT))
-            .collect();
-        before.push(barrier::image(
-            depth,
-            Use::DISCARD_AFTER_READERS,
-            Use::DEPTH_ATTACHMENT,
-        ));
-        barrier::images(gpu, cmd, &before);
+    /// Clears and fills the outputs with the scene, with the barriers of the
+    /// convention above on both sides.
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd, scene) = (ctx.gpu, ctx.cmd, ctx.scene);
+        let (colors, depth) = (self.outputs)(ctx.targets);
+        profiler.pass(gpu, cmd, self.name, GRAPHICS, || {
+            let mut before: Vec<_> = colors
+                .iter()
+                .map(|c| barrier::image(c, Use::DISCARD_AFTER_READERS, Use::COLOR_ATTACHMENT))
+                .collect();
+            before.push(barrier::image(
+                depth,
+                Use::DISCARD_AFTER_READERS,
+                Use::DEPTH_ATTACHMENT,
+            ));
+            barrier::images(gpu, cmd, &before);
 
-        let views: Vec<_> = colors.iter().map(|c| c.mip_views[0]).collect();
-        begin_rendering(
-            gpu,
-            cmd,
-            &Attachments::simple(&views, Some(depth.view), depth.extent),
-        );
-        let d = &gpu.device;
-        unsafe {
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, scene.set.set);
-            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-            d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
-            for draw in &scene.draws {
-                let cull = if draw.double_sided {
-                    vk::CullModeFlags::NONE
-                } else {
-                    vk::CullModeFlags::BACK
-                };
-                d.cmd_set_cull_mode(cmd, cull);
-                d.cmd_set_front_face(cmd, crate::vk::pipeline::FRONT_FACE);
-                d.cmd_push_constants(
+            let views = colors.map(|c| c.mip_views[0]);
+            begin_rendering(
+                gpu,
+                cmd,
+                &Attachments::simple(&views, Some(depth.view), depth.extent),
+            );
+            let d = &gpu.device;
+            unsafe {
+                self.pipeline.bind(
+                    gpu,
                     cmd,
-                    self.pipeline.layout,
-                    vk::ShaderStageFlags::ALL_GRAPHICS,
-                    0,
-                    bytes_of(&draw.push),
+                    vk::PipelineBindPoint::GRAPHICS,
+                    &[ctx.frame_set, scene.set.set],
                 );
-                d.cmd_draw_indexed(
-                    cmd,
-                    draw.index_count,
-                    1,
-                    draw.first_index,
-                    draw.vertex_offset,
-                    0,
-                );
+                d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+                d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+                for draw in &scene.draws {
+                    let cull = if draw.double_sided {
+                        vk::CullModeFlags::NONE
+                    } else {
+                        vk::CullModeFlags::BACK
+                    };
+                    d.cmd_set_cull_mode(cmd, cull);
+                    d.cmd_set_front_face(cmd, crate::vk::pipeline::FRONT_FACE);
+                    d.cmd_push_constants(
+                        cmd,
+                        self.pipeline.layout,
+                        vk::ShaderStageFlags::ALL_GRAPHICS,
+                        0,
+                        bytemuck::bytes_of(&draw.push),
+                    );
+                    d.cmd_draw_indexed(
+                        cmd,
+                        draw.index_count,
+                        1,
+                        draw.first_index,
+                        draw.vertex_offset,
+                        0,
+                    );
+                }
+                d.cmd_end_rendering(cmd);
             }
-            d.cmd_end_rendering(cmd);
-        }
-
-        let mut after: Vec<_> = colors
-            .iter()
-            .map(|c| barrier::image(c, Use::COLOR_ATTACHMENT, Use::READ_ONLY))
-            .collect();
-        after.push(barrier::image(depth, Use::DEPTH_ATTACHMENT, Use::READ_ONLY));
-        barrier::images(gpu, cmd, &after);
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
+            let mut after: Vec<_> = colors
+                .iter()
+                .map(|c| barrier::image(c, Use::COLOR_ATTACHMENT, Use::READ_ONLY))
+                .collect();
+            after.push(barrier::image(depth, Use::DEPTH_ATTACHMENT, Use::READ_ONLY));
+            barrier::images(gpu, cmd, &after);
+        });
     }
 }
 
-/// A pass that runs one fragment shader over every pixel of its outputs,
-/// reading its inputs with `texelFetch` (binding 0 is always the frame uniforms).
+/// A pass that runs one fragment shader over every pixel of one output,
+/// reading its inputs (set 1) with `texelFetch`: direct light, composite,
+/// tonemap and the full-resolution gather.
 pub struct FullscreenPass {
-    pipeline: Pipeline,
-    set: DescriptorSet,
+    name: &'static str,
+    kind: PassKind,
+    pipeline: PassPipeline,
+    output: fn(&Targets) -> &Image,
 }
 
 impl FullscreenPass {
+    /// `push_constant_bytes` of push constants for `record_with`.
     pub fn new(
-        gpu: &Gpu,
-        name: &str,
+        setup: &Setup,
+        name: &'static str,
+        kind: PassKind,
         fragment_shader: &str,
         bindings: &[Binding],
-        color_formats: &[vk::Format],
-    ) -> Result<Self> {
-        Self::with_push_constants(gpu, name, fragment_shader, bindings, color_formats, 0)
-    }
-
-    /// As `new`, with `push_constant_bytes` of push constants for `record_with`.
-    pub fn with_push_constants(
-        gpu: &Gpu,
-        name: &str,
-        fragment_shader: &str,
-        bindings: &[Binding],
-        color_formats: &[vk::Format],
         push_constant_bytes: u32,
+        output: fn(&Targets) -> &Image,
     ) -> Result<Self> {
-        let set = DescriptorSet::new(gpu, name, bindings)?;
-        let pipeline = Pipeline::graphics(
-            gpu,
-            &GraphicsDesc {
+        let pipeline = PassPipeline::graphics(
+            setup.gpu,
+            setup.frame,
+            bindings,
+            GraphicsDesc {
                 name,
                 vertex_shader: "fullscreen.vert",
                 fragment_shader,
-                set_layouts: &[set.layout],
                 push_constant_bytes,
-                color_formats,
+                color_formats: &[output(setup.targets).format],
                 ..Default::default()
             },
         )?;
-        Ok(Self { pipeline, set })
+        Ok(Self {
+            name,
+            kind,
+            pipeline,
+            output,
+        })
     }
 
-    /// Writes every pixel of `outputs`, with the convention's barriers.
-    pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer, outputs: &[&Image]) {
-        self.record_with(gpu, cmd, outputs, &[]);
+    /// Writes every pixel of the output, with the convention's barriers.
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        self.record_with(ctx, profiler, &[]);
     }
 
     /// As `record`, with push constants.
-    pub fn record_with(&self, gpu: &Gpu, cmd: vk::CommandBuffer, outputs: &[&Image], push: &[u8]) {
-        barrier::transition(
-            gpu,
-            cmd,
-            outputs,
-            Use::DISCARD_AFTER_READERS,
-            Use::COLOR_ATTACHMENT,
-        );
-        let views: Vec<_> = outputs.iter().map(|o| o.view).collect();
-        begin_rendering(
-            gpu,
-            cmd,
-            &Attachments::simple(&views, None, outputs[0].extent),
-        );
-        let d = &gpu.device;
-        unsafe {
-            self.pipeline
-                .bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, self.set.set);
-            if !push.is_empty() {
-                d.cmd_push_constants(
-                    cmd,
-                    self.pipeline.layout,
-                    vk::ShaderStageFlags::ALL_GRAPHICS,
-                    0,
-                    push,
-                );
+    pub fn record_with(&self, ctx: &FrameContext, profiler: &mut Profiler, push: &[u8]) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let output = (self.output)(ctx.targets);
+        profiler.pass(gpu, cmd, self.name, self.kind, || {
+            barrier::transition(
+                gpu,
+                cmd,
+                &[output],
+                Use::DISCARD_AFTER_READERS,
+                Use::COLOR_ATTACHMENT,
+            );
+            begin_rendering(
+                gpu,
+                cmd,
+                &Attachments::simple(&[output.view], None, output.extent),
+            );
+            let d = &gpu.device;
+            unsafe {
+                self.pipeline.bind(gpu, cmd, ctx.frame_set);
+                if !push.is_empty() {
+                    d.cmd_push_constants(
+                        cmd,
+                        self.pipeline.pipeline.layout,
+                        vk::ShaderStageFlags::ALL_GRAPHICS,
+                        0,
+                        push,
+                    );
+                }
+                d.cmd_draw(cmd, 3, 1, 0, 0);
+                d.cmd_end_rendering(cmd);
             }
-            d.cmd_draw(cmd, 3, 1, 0, 0);
-            d.cmd_end_rendering(cmd);
-        }
-        barrier::transition(gpu, cmd, outputs, Use::COLOR_ATTACHMENT, Use::READ_ONLY);
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
+            barrier::transition(gpu, cmd, &[output], Use::COLOR_ATTACHMENT, Use::READ_ONLY);
+        });
     }
 }
 
-/// Everything a pass may need while recording a frame.
-pub struct FrameContext<'a> {
-    pub gpu: &'a Gpu,
-    pub cmd: vk::CommandBuffer,
-    pub scene: &'a SceneGpu,
-    pub targets: &'a crate::renderer::Targets,
-}
-
-/// A compute shader with one descriptor set per dispatch variant (for example
-/// one per mip level: storage views of different levels need different sets).
+/// A compute shader with one descriptor set (set 1) per dispatch variant (for
+/// example one per mip level: storage views of different levels need
+/// different sets).
 pub struct ComputePass {
     pipeline: Pipeline,
     sets: Vec<DescriptorSet>,
@@ -365,22 +379,22 @@ pub struct ComputePass {
 impl ComputePass {
     /// `variants[i]` are the bindings of set `i`; all variants share one layout.
     pub fn new(
-        gpu: &Gpu,
+        setup: &Setup,
         name: &str,
         shader: &str,
         variants: &[Vec<Binding>],
         push_constant_bytes: u32,
         specialization: &[(u32, i32)],
     ) -> Result<Self> {
-        let mut sets = Vec::new();
-        for bindings in variants {
-            sets.push(DescriptorSet::new(gpu, name, bindings)?);
-        }
+        let sets = variants
+            .iter()
+            .map(|bindings| DescriptorSet::new(setup.gpu, name, bindings))
+            .collect::<Result<Vec<_>>>()?;
         let pipeline = Pipeline::compute(
-            gpu,
+            setup.gpu,
             name,
             shader,
-            &[sets[0].layout],
+            &[setup.frame, &sets[0]],
             push_constant_bytes,
             specialization,
         )?;
@@ -388,22 +402,16 @@ impl ComputePass {
     }
 
     /// Dispatches 8x8 workgroups covering `extent` with set `variant`.
-    pub fn dispatch(
-        &self,
-        gpu: &Gpu,
-        cmd: vk::CommandBuffer,
-        variant: usize,
-        push: &[u8],
-        extent: vk::Extent2D,
-    ) {
+    pub fn dispatch(&self, ctx: &FrameContext, variant: usize, push: &[u8], extent: vk::Extent2D) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let d = &gpu.device;
+        self.pipeline.bind(
+            gpu,
+            cmd,
+            vk::PipelineBindPoint::COMPUTE,
+            &[ctx.frame_set, self.sets[variant].set],
+        );
         unsafe {
-            self.pipeline.bind(
-                gpu,
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.sets[variant].set,
-            );
             if !push.is_empty() {
                 d.cmd_push_constants(
                     cmd,
@@ -416,21 +424,9 @@ impl ComputePass {
             d.cmd_dispatch(cmd, extent.width.div_ceil(8), extent.height.div_ceil(8), 1);
         }
     }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        for s in &mut self.sets {
-            s.destroy(gpu);
-        }
-    }
 }
 
-/// Timing kind of passes that exist only for indirect light.
-pub const INDIRECT_GRAPHICS: PassKind = PassKind {
-    graphics: true,
-    indirect: true,
-};
-pub const INDIRECT_COMPUTE: PassKind = PassKind {
-    graphics: false,
-    indirect: true,
-};
+/// Push-constant bytes of 32-bit values, in order.
+pub fn push_bytes(values: &[i32]) -> Vec<u8> {
+    bytemuck::cast_slice(values).to_vec()
+}

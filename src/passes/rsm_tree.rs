@@ -1,36 +1,36 @@
-//! Pass `rsm-tree`: the RSM quadtree (ALGORITHM.md section 2, patches) in the
+//! Pass `rsm-tree`: the RSM quadtree (docs/algorithm.md section 2, patches) in the
 //! mip chains of the RSM images, `shaders/rsm_tree.comp`, one dispatch per
 //! level, level k merging 2x2 texels of level k - 1 and flagging patches that
 //! span a discontinuity.
 //! Reads RSM mip 0; writes RSM mips 1.. (barriers below).
 
-use super::{ComputePass, FrameContext, INDIRECT_COMPUTE};
-use crate::renderer::Targets;
+use super::{ComputePass, INDIRECT_COMPUTE};
+use crate::frame::{FrameContext, Setup};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
-use crate::vk::{Buffer, Gpu};
 use anyhow::Result;
 
 pub struct RsmTreePass(ComputePass);
 
 impl RsmTreePass {
-    pub fn new(gpu: &Gpu, uniforms: &Buffer, t: &Targets) -> Result<Self> {
-        let images = [&t.rsm_position, &t.rsm_normal, &t.rsm_flux];
+    pub fn new(setup: &Setup) -> Result<Self> {
+        let t = setup.targets;
         let variants: Vec<Vec<Binding>> = (1..t.rsm_position.mips as usize)
             .map(|k| {
-                let src = images
-                    .iter()
-                    .map(|i| Binding::StorageImage(i.mip_views[k - 1]));
-                let dst = images.iter().map(|i| Binding::StorageImage(i.mip_views[k]));
-                std::iter::once(Binding::Uniform(uniforms))
-                    .chain(src)
-                    .chain(dst)
-                    .collect()
+                let (src, dst) = (k - 1, k);
+                vec![
+                    Binding::storage_image("src_position", t.rsm_position.mip_views[src]),
+                    Binding::storage_image("src_normal", t.rsm_normal.mip_views[src]),
+                    Binding::storage_image("src_flux", t.rsm_flux.mip_views[src]),
+                    Binding::storage_image("dst_position", t.rsm_position.mip_views[dst]),
+                    Binding::storage_image("dst_normal", t.rsm_normal.mip_views[dst]),
+                    Binding::storage_image("dst_flux", t.rsm_flux.mip_views[dst]),
+                ]
             })
             .collect();
         Ok(Self(ComputePass::new(
-            gpu,
+            setup,
             "rsm-tree",
             "rsm_tree.comp",
             &variants,
@@ -62,13 +62,9 @@ impl RsmTreePass {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 self.0
-                    .dispatch(gpu, cmd, k as usize - 1, &[], t.rsm_position.mip_extent(k));
+                    .dispatch(ctx, k as usize - 1, &[], t.rsm_position.mip_extent(k));
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });
-    }
-
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
     }
 }

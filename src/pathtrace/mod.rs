@@ -1,4 +1,4 @@
-//! Method `pathtrace` (ALGORITHM.md sections 1 and 5): a one-bounce diffuse
+//! Method `pathtrace` (docs/algorithm.md sections 1 and 5): a one-bounce diffuse
 //! reference WITH indirect visibility, on the CPU (all cores, rayon), from the
 //! same spot light, camera and materials as the rasterizer. It shows the error
 //! that ignoring indirect visibility causes, which every VPL method shares.
@@ -13,7 +13,7 @@
 
 pub mod bvh;
 
-use crate::renderer::{frame_uniforms, Readback, RenderSettings, RsmReadback};
+use crate::readback::{Readback, RsmReadback};
 use crate::scene::{Scene, SpotLight};
 use bvh::{Bvh, Cull, Triangle};
 use glam::{Mat4, Vec2, Vec3, Vec3A, Vec4};
@@ -242,15 +242,7 @@ pub fn render(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Readback {
     let shading = Shading::new(scene);
-    let uniforms = frame_uniforms(
-        scene,
-        &RenderSettings {
-            width: s.width,
-            height: s.height,
-            ..Default::default()
-        },
-    );
-    let clip_to_world = Mat4::from_cols_array_2d(&uniforms.camera_view_proj).inverse();
+    let clip_to_world = crate::view::camera_view_proj(&scene.camera, s.width, s.height).inverse();
     let eye = Vec3A::from(scene.camera.position());
     let forward = Vec3A::from(scene.camera.forward());
     let (w, h) = (s.width as usize, s.height as usize);

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// One vertex as the vertex shaders read it (`shaders/scene.vert`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuVertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],

@@ -6,7 +6,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_void, CStr};
 use std::mem::ManuallyDrop;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -94,9 +94,41 @@ impl ValidationLog {
     }
 }
 
+/// What every Vulkan object's owner needs to free it: the device, the
+/// allocator, and (destroyed last, in `Drop`) the messenger and the instance.
+/// Resources hold an `Arc` of it, so the device outlives every object made
+/// from it, whatever order values are dropped in.
+pub struct Shared {
+    pub device: ash::Device,
+    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    instance: ash::Instance,
+    debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// Kept alive until the messenger that writes to it is gone.
+    _validation_log: Option<Arc<ValidationLog>>,
+    /// The loaded Vulkan library, unloaded only after everything above is
+    /// destroyed (fields drop after `drop`).
+    _entry: ash::Entry,
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            ManuallyDrop::drop(&mut self.allocator);
+            // The validation layer reports objects still alive here.
+            self.device.destroy_device(None);
+            if let Some((loader, messenger)) = self.debug_utils.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
 pub struct Gpu {
     pub entry: ash::Entry,
     pub instance: ash::Instance,
+    /// The same device as `shared.device`, for recording commands.
     pub device: ash::Device,
     pub physical: vk::PhysicalDevice,
     pub queue: vk::Queue,
@@ -104,14 +136,13 @@ pub struct Gpu {
     pub properties: vk::PhysicalDeviceProperties,
     pub info: DeviceInfo,
     pub features: OptionalFeatures,
-    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub shared: Arc<Shared>,
     pub command_pool: vk::CommandPool,
     /// Signalled by each `submit_and_wait`; reused rather than made per submission.
     submit_fence: vk::Fence,
-    debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Object names and command labels, present when VK_EXT_debug_utils is.
     pub debug_device: Option<ash::ext::debug_utils::Device>,
-    validation_log: Option<Box<ValidationLog>>,
+    validation_log: Option<Arc<ValidationLog>>,
 }
 
 unsafe extern "system" fn debug_callback(
@@ -312,7 +343,7 @@ impl Gpu {
             validation_log: None,
         };
         if validate {
-            let log = Box::new(ValidationLog::default());
+            let log = Arc::new(ValidationLog::default());
             let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
                 .message_severity(
@@ -325,7 +356,7 @@ impl Gpu {
                         | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL,
                 )
                 .pfn_user_callback(Some(debug_callback))
-                .user_data(&*log as *const ValidationLog as *mut c_void);
+                .user_data(Arc::as_ptr(&log) as *mut c_void);
             let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
                 .context("creating the validation debug messenger")?;
             guard.debug_utils = Some((loader, messenger));
@@ -417,16 +448,37 @@ impl Gpu {
             .with_context(|| format!("creating a Vulkan device on {}", info.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
 
-        let allocator = Allocator::new(&AllocatorCreateDesc {
+        let allocator = match Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        })
-        .context("creating the GPU memory allocator")?;
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { device.destroy_device(None) };
+                return Err(anyhow::Error::from(e).context("creating the GPU memory allocator"));
+            }
+        };
 
+        // From here on `Shared` owns the device, allocator, messenger and
+        // instance, and frees them when its last holder is gone.
+        guard.instance = None;
+        let debug_utils = guard.debug_utils.take();
+        let validation_log = guard.validation_log.take();
+        let debug_device = debug_utils
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        let shared = Arc::new(Shared {
+            device: device.clone(),
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            instance: instance.clone(),
+            debug_utils,
+            _validation_log: validation_log.clone(),
+            _entry: entry.clone(),
+        });
         let command_pool = unsafe {
             device.create_command_pool(
                 &vk::CommandPoolCreateInfo::default()
@@ -435,14 +487,14 @@ impl Gpu {
                 None,
             )
         }?;
-        let submit_fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }?;
-        // Success: the Gpu owns what the guard held.
-        guard.instance = None;
-        let debug_utils = guard.debug_utils.take();
-        let validation_log = guard.validation_log.take();
-        let debug_device = debug_utils
-            .as_ref()
-            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        let submit_fence =
+            match unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) } {
+                Ok(f) => f,
+                Err(e) => {
+                    unsafe { device.destroy_command_pool(command_pool, None) };
+                    return Err(e.into());
+                }
+            };
         Ok(Self {
             entry,
             instance,
@@ -453,10 +505,9 @@ impl Gpu {
             properties,
             info,
             features,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            shared,
             command_pool,
             submit_fence,
-            debug_utils,
             debug_device,
             validation_log,
         })
@@ -465,6 +516,12 @@ impl Gpu {
     /// True when the validation layer is loaded.
     pub fn validating(&self) -> bool {
         self.validation_log.is_some()
+    }
+
+    /// The validation log itself, to read what the layer reports while the
+    /// device is destroyed (undestroyed objects), after the `Gpu` is gone.
+    pub fn validation_log(&self) -> Option<Arc<ValidationLog>> {
+        self.validation_log.clone()
     }
 
     /// Validation messages reported since the last call.
@@ -505,20 +562,21 @@ impl Gpu {
     /// Submits `cmd` and blocks until the GPU has finished it.
     pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
         let fence = self.submit_fence;
+        unsafe { self.device.reset_fences(&[fence]) }.map_err(submit_error)?;
+        self.submit(cmd, fence)?;
+        self.wait(fence)
+    }
+
+    /// Submits `cmd`; `fence` (unsignalled) is signalled when it finishes.
+    pub fn submit(&self, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<()> {
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-        let result = unsafe {
-            self.device
-                .reset_fences(&[fence])
-                .and_then(|_| self.device.queue_submit2(self.queue, &submit, fence))
-                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX))
-        };
-        result.map_err(|e| match e {
-            vk::Result::ERROR_DEVICE_LOST => anyhow!(
-                "the GPU device was lost (a driver timeout or crash); try a smaller --width/--height or --rsm"
-            ),
-            e => anyhow!("queue submission failed: {e}"),
-        })
+        unsafe { self.device.queue_submit2(self.queue, &submit, fence) }.map_err(submit_error)
+    }
+
+    /// Blocks until `fence` is signalled.
+    pub fn wait(&self, fence: vk::Fence) -> Result<()> {
+        unsafe { self.device.wait_for_fences(&[fence], true, u64::MAX) }.map_err(submit_error)
     }
 
     /// Records commands with `record` into a fresh command buffer, runs them and waits.
@@ -555,19 +613,28 @@ impl Gpu {
     }
 }
 
+/// What a failed submission or wait means for the user.
+fn submit_error(e: vk::Result) -> anyhow::Error {
+    match e {
+        vk::Result::ERROR_DEVICE_LOST => anyhow!(
+            "the GPU device was lost (a driver timeout or crash); no output was written. \
+             Try a smaller --width/--height or --rsm, or a lighter method"
+        ),
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => anyhow!(
+            "the GPU ran out of memory ({e}); no output was written. Try a smaller --width/--height or --rsm"
+        ),
+        e => anyhow!("queue submission failed: {e}"),
+    }
+}
+
 impl Drop for Gpu {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_fence(self.submit_fence, None);
             self.device.destroy_command_pool(self.command_pool, None);
-            ManuallyDrop::drop(&mut self.allocator);
-            self.device.destroy_device(None);
-            if let Some((loader, messenger)) = self.debug_utils.take() {
-                loader.destroy_debug_utils_messenger(messenger, None);
-            }
-            self.instance.destroy_instance(None);
         }
+        // `shared` goes with the last resource that holds it.
     }
 }
 
@@ -576,7 +643,7 @@ impl Drop for Gpu {
 struct InstanceGuard {
     instance: Option<ash::Instance>,
     debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-    validation_log: Option<Box<ValidationLog>>,
+    validation_log: Option<Arc<ValidationLog>>,
 }
 
 impl Drop for InstanceGuard {

@@ -4,7 +4,8 @@ pub mod barrier;
 pub mod context;
 pub mod pipeline;
 pub mod profiler;
+pub mod reflect;
 pub mod resources;
 
 pub use context::{Gpu, GpuOptions, Validation};
-pub use resources::{Buffer, Image, ImageDesc};
+pub use resources::{Buffer, Image, ImageDesc, Sampler};

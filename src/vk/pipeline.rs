@@ -1,9 +1,11 @@
 //! Shader modules from the embedded SPIR-V, descriptor sets, and graphics
 //! pipelines for dynamic rendering.
 
-use super::Gpu;
-use anyhow::{anyhow, Context as _, Result};
+use super::context::Shared;
+use super::{reflect, Gpu};
+use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
+use std::sync::Arc;
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
@@ -53,9 +55,9 @@ fn shader_module(gpu: &Gpu, name: &str) -> Result<vk::ShaderModule> {
     Ok(module)
 }
 
-/// One descriptor binding, visible to every shader stage of the pipeline.
+/// The resource of one descriptor binding.
 #[derive(Clone, Copy)]
-pub enum Binding<'a> {
+pub enum Resource<'a> {
     Uniform(&'a super::Buffer),
     Storage(&'a super::Buffer),
     /// A combined image sampler in `SHADER_READ_ONLY_OPTIMAL`.
@@ -66,32 +68,109 @@ pub enum Binding<'a> {
     StorageImage(vk::ImageView),
 }
 
-/// A descriptor set layout, its pool and the one set allocated from it.
-/// Passes write their set once at creation: their inputs never change.
+/// One descriptor binding, visible to every shader stage of the pipeline. Its
+/// `name` is the shader's name for it (the variable, or the block for a block
+/// without an instance name); pipelines check it against the SPIR-V.
+#[derive(Clone, Copy)]
+pub struct Binding<'a> {
+    pub name: &'static str,
+    pub resource: Resource<'a>,
+}
+
+impl<'a> Binding<'a> {
+    pub fn uniform(name: &'static str, buffer: &'a super::Buffer) -> Self {
+        Self {
+            name,
+            resource: Resource::Uniform(buffer),
+        }
+    }
+    pub fn storage(name: &'static str, buffer: &'a super::Buffer) -> Self {
+        Self {
+            name,
+            resource: Resource::Storage(buffer),
+        }
+    }
+    pub fn sampled(name: &'static str, view: vk::ImageView, sampler: vk::Sampler) -> Self {
+        Self {
+            name,
+            resource: Resource::Sampled(view, sampler),
+        }
+    }
+    pub fn sampled_array(
+        name: &'static str,
+        views: &'a [vk::ImageView],
+        sampler: vk::Sampler,
+    ) -> Self {
+        Self {
+            name,
+            resource: Resource::SampledArray(views, sampler),
+        }
+    }
+    pub fn storage_image(name: &'static str, view: vk::ImageView) -> Self {
+        Self {
+            name,
+            resource: Resource::StorageImage(view),
+        }
+    }
+
+    fn kind(&self) -> (vk::DescriptorType, u32, reflect::Kind) {
+        match self.resource {
+            Resource::StorageImage(_) => (
+                vk::DescriptorType::STORAGE_IMAGE,
+                1,
+                reflect::Kind::StorageImage,
+            ),
+            Resource::Uniform(_) => (
+                vk::DescriptorType::UNIFORM_BUFFER,
+                1,
+                reflect::Kind::UniformBuffer,
+            ),
+            Resource::Storage(_) => (
+                vk::DescriptorType::STORAGE_BUFFER,
+                1,
+                reflect::Kind::StorageBuffer,
+            ),
+            Resource::Sampled(..) => (
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                1,
+                reflect::Kind::CombinedImageSampler,
+            ),
+            Resource::SampledArray(views, _) => (
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                views.len() as u32,
+                reflect::Kind::CombinedImageSampler,
+            ),
+        }
+    }
+}
+
+/// What one binding of a set is, kept for the reflection check.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BindingInfo {
+    pub name: &'static str,
+    pub kind: reflect::Kind,
+}
+
+/// A descriptor set layout, its pool and the one set allocated from it, freed
+/// when dropped. Sets are written once at creation: what a pass reads never
+/// changes; what changes per frame lives in the frame set (see `frame`).
 pub struct DescriptorSet {
     pub layout: vk::DescriptorSetLayout,
     pub pool: vk::DescriptorPool,
     pub set: vk::DescriptorSet,
+    /// Binding i's name and kind.
+    pub bindings: Vec<BindingInfo>,
+    shared: Arc<Shared>,
 }
 
 impl DescriptorSet {
     pub fn new(gpu: &Gpu, name: &str, bindings: &[Binding]) -> Result<Self> {
         let stages = vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE;
-        let kind = |b: &Binding| match b {
-            Binding::StorageImage(_) => (vk::DescriptorType::STORAGE_IMAGE, 1),
-            Binding::Uniform(_) => (vk::DescriptorType::UNIFORM_BUFFER, 1),
-            Binding::Storage(_) => (vk::DescriptorType::STORAGE_BUFFER, 1),
-            Binding::Sampled(..) => (vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-            Binding::SampledArray(views, _) => (
-                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                views.len() as u32,
-            ),
-        };
         let layout_bindings: Vec<_> = bindings
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let (ty, count) = kind(b);
+                let (ty, count, _) = b.kind();
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(i as u32)
                     .descriptor_type(ty)
@@ -99,7 +178,20 @@ impl DescriptorSet {
                     .stage_flags(stages)
             })
             .collect();
-        let layout = unsafe {
+        let mut out = Self {
+            layout: vk::DescriptorSetLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+            bindings: bindings
+                .iter()
+                .map(|b| BindingInfo {
+                    name: b.name,
+                    kind: b.kind().2,
+                })
+                .collect(),
+            shared: gpu.shared.clone(),
+        };
+        out.layout = unsafe {
             gpu.device.create_descriptor_set_layout(
                 &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
                 None,
@@ -112,7 +204,7 @@ impl DescriptorSet {
                 descriptor_count: b.descriptor_count,
             })
             .collect();
-        let pool = unsafe {
+        out.pool = unsafe {
             gpu.device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
                     .max_sets(1)
@@ -120,11 +212,11 @@ impl DescriptorSet {
                 None,
             )
         }?;
-        let layouts = [layout];
-        let set = unsafe {
+        let layouts = [out.layout];
+        out.set = unsafe {
             gpu.device.allocate_descriptor_sets(
                 &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
+                    .descriptor_pool(out.pool)
                     .set_layouts(&layouts),
             )
         }
@@ -132,8 +224,8 @@ impl DescriptorSet {
 
         let buffer_infos: Vec<Vec<vk::DescriptorBufferInfo>> = bindings
             .iter()
-            .map(|b| match b {
-                Binding::Uniform(buf) | Binding::Storage(buf) => vec![vk::DescriptorBufferInfo {
+            .map(|b| match b.resource {
+                Resource::Uniform(buf) | Resource::Storage(buf) => vec![vk::DescriptorBufferInfo {
                     buffer: buf.buffer,
                     offset: 0,
                     range: vk::WHOLE_SIZE,
@@ -149,15 +241,15 @@ impl DescriptorSet {
                     image_view: view,
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 };
-                match b {
-                    Binding::StorageImage(view) => vec![vk::DescriptorImageInfo {
+                match b.resource {
+                    Resource::StorageImage(view) => vec![vk::DescriptorImageInfo {
                         sampler: vk::Sampler::null(),
-                        image_view: *view,
+                        image_view: view,
                         image_layout: vk::ImageLayout::GENERAL,
                     }],
-                    Binding::Sampled(view, sampler) => vec![info(*view, *sampler)],
-                    Binding::SampledArray(views, sampler) => {
-                        views.iter().map(|v| info(*v, *sampler)).collect()
+                    Resource::Sampled(view, sampler) => vec![info(view, sampler)],
+                    Resource::SampledArray(views, sampler) => {
+                        views.iter().map(|v| info(*v, sampler)).collect()
                     }
                     _ => vec![],
                 }
@@ -168,7 +260,7 @@ impl DescriptorSet {
             .enumerate()
             .map(|(i, lb)| {
                 let w = vk::WriteDescriptorSet::default()
-                    .dst_set(set)
+                    .dst_set(out.set)
                     .dst_binding(i as u32)
                     .descriptor_type(lb.descriptor_type);
                 if buffer_infos[i].is_empty() {
@@ -179,15 +271,103 @@ impl DescriptorSet {
             })
             .collect();
         unsafe { gpu.device.update_descriptor_sets(&writes, &[]) };
-        Ok(Self { layout, pool, set })
+        Ok(out)
     }
+}
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
+impl Drop for DescriptorSet {
+    fn drop(&mut self) {
         unsafe {
-            gpu.device.destroy_descriptor_pool(self.pool, None);
-            gpu.device.destroy_descriptor_set_layout(self.layout, None);
+            // Null handles (a set whose creation failed half-way) are ignored.
+            self.shared.device.destroy_descriptor_pool(self.pool, None);
+            self.shared
+                .device
+                .destroy_descriptor_set_layout(self.layout, None);
         }
     }
+}
+
+/// Checks that `sets` provide, at every (set, binding) that `shaders` declare,
+/// a resource of the kind and name the shader expects, and that every binding
+/// of the pass's own sets (all but set 0, the frame set, which shaders may use
+/// in part) is read by some stage.
+pub fn check_bindings(pipeline: &str, shaders: &[&str], sets: &[&[BindingInfo]]) -> Result<()> {
+    let mut declared: Vec<(String, reflect::ShaderBinding)> = Vec::new();
+    for shader in shaders {
+        for b in reflect::bindings(&spirv(shader)?)? {
+            declared.push((shader.to_string(), b));
+        }
+    }
+    for (shader, b) in &declared {
+        let Some(set) = sets.get(b.set as usize) else {
+            bail!(
+                "pipeline {pipeline}: {shader} reads set {} binding {} (`{}`), but the pass binds {} set(s)",
+                b.set,
+                b.binding,
+                b.name,
+                sets.len()
+            );
+        };
+        match set.get(b.binding as usize) {
+            Some(host) if host.name == b.name && host.kind == b.kind => {}
+            Some(host) => bail!(
+                "pipeline {pipeline}: {shader} expects `{}` ({:?}) at set {} binding {}, but the pass binds `{}` ({:?}) there",
+                b.name,
+                b.kind,
+                b.set,
+                b.binding,
+                host.name,
+                host.kind
+            ),
+            None => bail!(
+                "pipeline {pipeline}: {shader} reads `{}` at set {} binding {}, which the pass does not bind",
+                b.name,
+                b.set,
+                b.binding
+            ),
+        }
+    }
+    for (s, set) in sets.iter().enumerate().skip(1) {
+        for (i, host) in set.iter().enumerate() {
+            let read = declared
+                .iter()
+                .any(|(_, b)| b.set as usize == s && b.binding as usize == i);
+            if !read {
+                bail!(
+                    "pipeline {pipeline}: the pass binds `{}` at set {s} binding {i}, which none of {shaders:?} reads",
+                    host.name
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+thread_local! {
+    /// Test hook: pipelines this thread may still create before one fails.
+    static PIPELINES_BEFORE_FAILURE: std::cell::Cell<Option<u32>> = const { std::cell::Cell::new(None) };
+}
+
+/// Makes the pipeline creation after the next `n` on this thread fail, so a
+/// test can show that setup failing half-way frees what it had made. `None`
+/// switches the failure off.
+#[doc(hidden)]
+pub fn fail_pipeline_creation_after(n: Option<u32>) {
+    PIPELINES_BEFORE_FAILURE.with(|c| c.set(n));
+}
+
+fn injected_failure(name: &str) -> Result<()> {
+    PIPELINES_BEFORE_FAILURE.with(|c| match c.get() {
+        Some(0) => {
+            c.set(None);
+            bail!("creating pipeline {name}: failure injected by a test")
+        }
+        Some(n) => {
+            c.set(Some(n - 1));
+            Ok(())
+        }
+        None => Ok(()),
+    })
 }
 
 /// glTF front faces are counter-clockwise seen from the front. Vulkan's
@@ -200,7 +380,8 @@ pub struct GraphicsDesc<'a> {
     pub name: &'a str,
     pub vertex_shader: &'a str,
     pub fragment_shader: &'a str,
-    pub set_layouts: &'a [vk::DescriptorSetLayout],
+    /// Set i of the pipeline layout (checked against the shaders' bindings).
+    pub sets: &'a [&'a DescriptorSet],
     pub push_constant_bytes: u32,
     /// Scene vertex input (`scene::GpuVertex`); `false` for full-screen triangles.
     pub scene_vertices: bool,
@@ -225,7 +406,7 @@ impl Default for GraphicsDesc<'_> {
             name: "",
             vertex_shader: "fullscreen.vert",
             fragment_shader: "",
-            set_layouts: &[],
+            sets: &[],
             push_constant_bytes: 0,
             scene_vertices: false,
             color_formats: &[],
@@ -272,26 +453,61 @@ impl StencilTest {
     };
 }
 
+/// A pipeline and its layout, destroyed when dropped.
 pub struct Pipeline {
     pub pipeline: vk::Pipeline,
     pub layout: vk::PipelineLayout,
+    shared: Arc<Shared>,
 }
 
 impl Pipeline {
-    pub fn graphics(gpu: &Gpu, desc: &GraphicsDesc) -> Result<Self> {
-        let push = [vk::PushConstantRange {
-            stage_flags: vk::ShaderStageFlags::ALL_GRAPHICS,
-            offset: 0,
-            size: desc.push_constant_bytes,
-        }];
-        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(desc.set_layouts);
-        if desc.push_constant_bytes > 0 {
-            layout_info = layout_info.push_constant_ranges(&push);
+    /// Checks the shaders' bindings against `sets` and makes the layout; the
+    /// returned value (null pipeline) frees the layout if a later step fails.
+    fn with_layout(
+        gpu: &Gpu,
+        name: &str,
+        shaders: &[&str],
+        sets: &[&DescriptorSet],
+        push: vk::PushConstantRange,
+    ) -> Result<Self> {
+        let infos: Vec<&[BindingInfo]> = sets.iter().map(|s| s.bindings.as_slice()).collect();
+        check_bindings(name, shaders, &infos)?;
+        injected_failure(name)?;
+        let layouts: Vec<_> = sets.iter().map(|s| s.layout).collect();
+        let ranges = [push];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts);
+        if push.size > 0 {
+            layout_info = layout_info.push_constant_ranges(&ranges);
         }
         let layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }?;
+        Ok(Self {
+            pipeline: vk::Pipeline::null(),
+            layout,
+            shared: gpu.shared.clone(),
+        })
+    }
 
+    pub fn graphics(gpu: &Gpu, desc: &GraphicsDesc) -> Result<Self> {
+        let mut out = Self::with_layout(
+            gpu,
+            desc.name,
+            &[desc.vertex_shader, desc.fragment_shader],
+            desc.sets,
+            vk::PushConstantRange {
+                stage_flags: vk::ShaderStageFlags::ALL_GRAPHICS,
+                offset: 0,
+                size: desc.push_constant_bytes,
+            },
+        )?;
+        let layout = out.layout;
         let vs = shader_module(gpu, desc.vertex_shader)?;
-        let fs = shader_module(gpu, desc.fragment_shader)?;
+        let fs = match shader_module(gpu, desc.fragment_shader) {
+            Ok(fs) => fs,
+            Err(e) => {
+                unsafe { gpu.device.destroy_shader_module(vs, None) };
+                return Err(e);
+            }
+        };
         let (spec_entries, spec_data) = specialization_data(desc.specialization);
         let spec = vk::SpecializationInfo::default()
             .map_entries(&spec_entries)
@@ -403,9 +619,9 @@ impl Pipeline {
             gpu.device.destroy_shader_module(vs, None);
             gpu.device.destroy_shader_module(fs, None);
         }
-        let pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {}: {e}", desc.name))?[0];
-        gpu.name(pipeline, desc.name);
-        Ok(Self { pipeline, layout })
+        out.pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {}: {e}", desc.name))?[0];
+        gpu.name(out.pipeline, desc.name);
+        Ok(out)
     }
 
     /// A compute pipeline running `shader` (entry `main`).
@@ -413,20 +629,22 @@ impl Pipeline {
         gpu: &Gpu,
         name: &str,
         shader: &str,
-        set_layouts: &[vk::DescriptorSetLayout],
+        sets: &[&DescriptorSet],
         push_constant_bytes: u32,
         specialization: &[(u32, i32)],
     ) -> Result<Self> {
-        let push = [vk::PushConstantRange {
-            stage_flags: vk::ShaderStageFlags::COMPUTE,
-            offset: 0,
-            size: push_constant_bytes,
-        }];
-        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(set_layouts);
-        if push_constant_bytes > 0 {
-            layout_info = layout_info.push_constant_ranges(&push);
-        }
-        let layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }?;
+        let mut out = Self::with_layout(
+            gpu,
+            name,
+            &[shader],
+            sets,
+            vk::PushConstantRange {
+                stage_flags: vk::ShaderStageFlags::COMPUTE,
+                offset: 0,
+                size: push_constant_bytes,
+            },
+        )?;
+        let layout = out.layout;
         let module = shader_module(gpu, shader)?;
         let (spec_entries, spec_data) = specialization_data(specialization);
         let spec = vk::SpecializationInfo::default()
@@ -445,30 +663,71 @@ impl Pipeline {
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
         };
         unsafe { gpu.device.destroy_shader_module(module, None) };
-        let pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {name}: {e}"))?[0];
-        gpu.name(pipeline, name);
-        Ok(Self { pipeline, layout })
+        out.pipeline = result.map_err(|(_, e)| anyhow!("creating pipeline {name}: {e}"))?[0];
+        gpu.name(out.pipeline, name);
+        Ok(out)
     }
 
-    /// Binds the pipeline and `set` (as set 0) for graphics or compute.
+    /// Binds the pipeline with `sets` (set 0 first) for graphics or compute.
     pub fn bind(
         &self,
         gpu: &Gpu,
         cmd: vk::CommandBuffer,
         point: vk::PipelineBindPoint,
-        set: vk::DescriptorSet,
+        sets: &[vk::DescriptorSet],
     ) {
         unsafe {
             gpu.device.cmd_bind_pipeline(cmd, point, self.pipeline);
             gpu.device
-                .cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[set], &[]);
+                .cmd_bind_descriptor_sets(cmd, point, self.layout, 0, sets, &[]);
         }
     }
+}
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
+impl Drop for Pipeline {
+    fn drop(&mut self) {
         unsafe {
-            gpu.device.destroy_pipeline(self.pipeline, None);
-            gpu.device.destroy_pipeline_layout(self.layout, None);
+            self.shared.device.destroy_pipeline(self.pipeline, None);
+            self.shared
+                .device
+                .destroy_pipeline_layout(self.layout, None);
         }
+    }
+}
+
+/// A graphics pipeline with the one descriptor set of its own (set 1) that
+/// many passes pair it with; set 0 is the frame set.
+pub struct PassPipeline {
+    pub pipeline: Pipeline,
+    pub set: DescriptorSet,
+}
+
+impl PassPipeline {
+    /// `desc.sets` is filled in: [`frame`, the set made from `bindings`].
+    pub fn graphics(
+        gpu: &Gpu,
+        frame: &DescriptorSet,
+        bindings: &[Binding],
+        desc: GraphicsDesc,
+    ) -> Result<Self> {
+        let set = DescriptorSet::new(gpu, desc.name, bindings)?;
+        let pipeline = Pipeline::graphics(
+            gpu,
+            &GraphicsDesc {
+                sets: &[frame, &set],
+                ..desc
+            },
+        )?;
+        Ok(Self { pipeline, set })
+    }
+
+    /// Binds the pipeline, `frame_set` as set 0 and its own set as set 1.
+    pub fn bind(&self, gpu: &Gpu, cmd: vk::CommandBuffer, frame_set: vk::DescriptorSet) {
+        self.pipeline.bind(
+            gpu,
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            &[frame_set, self.set.set],
+        );
     }
 }

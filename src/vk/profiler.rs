@@ -13,12 +13,14 @@
 //! rasterized block, stencil- and depth-rejected ones included, so the occlusion
 //! query (`samples_passed`) is what counts fragments that pass the tests.
 
+use super::context::Shared;
 use super::Gpu;
 use anyhow::Result;
 use ash::vk;
+use std::sync::Arc;
 
 /// What kind of work a pass does, for the queries it can hold and the
-/// "indirect time" sum (ALGORITHM.md section 6).
+/// "indirect time" sum (docs/algorithm.md section 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassKind {
     /// Draws inside a render-pass instance (occlusion queries are meaningful).
@@ -47,6 +49,7 @@ pub struct Profiler {
     timestamp_mask: u64,
     ns_per_tick: f64,
     passes: Vec<(&'static str, PassKind)>,
+    shared: Arc<Shared>,
 }
 
 const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFlags::from_raw(
@@ -66,29 +69,6 @@ impl Profiler {
                 None,
             )
         };
-        let timestamps = if gpu.features.timestamps {
-            Some(create(
-                vk::QueryType::TIMESTAMP,
-                capacity + 1,
-                vk::QueryPipelineStatisticFlags::empty(),
-            )?)
-        } else {
-            None
-        };
-        let statistics = if gpu.features.pipeline_statistics {
-            Some(create(
-                vk::QueryType::PIPELINE_STATISTICS,
-                capacity,
-                STATISTICS,
-            )?)
-        } else {
-            None
-        };
-        let occlusion = create(
-            vk::QueryType::OCCLUSION,
-            capacity,
-            vk::QueryPipelineStatisticFlags::empty(),
-        )?;
         let bits = unsafe {
             gpu.instance
                 .get_physical_device_queue_family_properties(gpu.physical)
@@ -99,18 +79,39 @@ impl Profiler {
         } else {
             (1u64 << bits) - 1
         };
-        Ok(Self {
+        // Pools are created into `out`, whose `Drop` frees them if a later one fails.
+        let mut out = Self {
             capacity,
-            timestamps,
-            statistics,
-            occlusion,
+            timestamps: None,
+            statistics: None,
+            occlusion: vk::QueryPool::null(),
             precise_occlusion: gpu.features.precise_occlusion,
             timestamp_mask,
             ns_per_tick: gpu.properties.limits.timestamp_period as f64,
             passes: Vec::new(),
-        })
+            shared: gpu.shared.clone(),
+        };
+        if gpu.features.timestamps {
+            out.timestamps = Some(create(
+                vk::QueryType::TIMESTAMP,
+                capacity + 1,
+                vk::QueryPipelineStatisticFlags::empty(),
+            )?);
+        }
+        if gpu.features.pipeline_statistics {
+            out.statistics = Some(create(
+                vk::QueryType::PIPELINE_STATISTICS,
+                capacity,
+                STATISTICS,
+            )?);
+        }
+        out.occlusion = create(
+            vk::QueryType::OCCLUSION,
+            capacity,
+            vk::QueryPipelineStatisticFlags::empty(),
+        )?;
+        Ok(out)
     }
-
     /// Resets the pools and writes the frame's first timestamp.
     pub fn begin_frame(&mut self, gpu: &Gpu, cmd: vk::CommandBuffer) {
         self.passes.clear();
@@ -258,16 +259,19 @@ impl Profiler {
         }
         Ok(merged)
     }
+}
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
+impl Drop for Profiler {
+    fn drop(&mut self) {
+        let d = &self.shared.device;
         unsafe {
-            if let Some(p) = self.timestamps.take() {
-                gpu.device.destroy_query_pool(p, None);
+            for p in [self.timestamps.take(), self.statistics.take()]
+                .into_iter()
+                .flatten()
+            {
+                d.destroy_query_pool(p, None);
             }
-            if let Some(p) = self.statistics.take() {
-                gpu.device.destroy_query_pool(p, None);
-            }
-            gpu.device.destroy_query_pool(self.occlusion, None);
+            d.destroy_query_pool(self.occlusion, None);
         }
     }
 }

@@ -1,11 +1,14 @@
-//! Images and buffers backed by gpu-allocator. Owners call `destroy` explicitly
-//! (the renderer does so in its `Drop`), so no resource outlives its device.
+//! Images, buffers and samplers backed by gpu-allocator. Each frees itself
+//! when dropped; it holds the device (`Arc<Shared>`), so the device outlives it
+//! and an error half-way through setup leaks nothing.
 
+use super::context::Shared;
 use super::Gpu;
 use anyhow::{Context as _, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
 
 pub struct Image {
     pub image: vk::Image,
@@ -20,6 +23,7 @@ pub struct Image {
     pub mips: u32,
     pub aspect: vk::ImageAspectFlags,
     allocation: Option<Allocation>,
+    shared: Arc<Shared>,
 }
 
 #[derive(Clone, Copy)]
@@ -98,8 +102,22 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let image = unsafe { gpu.device.create_image(&info, None) }
             .with_context(|| format!("creating image {}", desc.name))?;
+        // From here on `Drop` frees whatever exists (null handles are skipped).
+        let mut out = Self {
+            image,
+            view: vk::ImageView::null(),
+            mip_views: Vec::new(),
+            format: desc.format,
+            extent: desc.extent,
+            layers: desc.layers,
+            mips: desc.mips,
+            aspect,
+            allocation: None,
+            shared: gpu.shared.clone(),
+        };
         let requirements = unsafe { gpu.device.get_image_memory_requirements(image) };
         let allocation = gpu
+            .shared
             .allocator
             .lock()
             .unwrap()
@@ -119,18 +137,11 @@ impl Image {
                     desc.extent.height,
                     desc.layers
                 )
-            });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
-                unsafe { gpu.device.destroy_image(image, None) };
-                return Err(e);
-            }
-        };
-        unsafe {
-            gpu.device
-                .bind_image_memory(image, allocation.memory(), allocation.offset())?
-        };
+            })?;
+        // SAFETY: the memory is bound to this object only, and freed after it.
+        let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
+        out.allocation = Some(allocation);
+        unsafe { gpu.device.bind_image_memory(image, memory, offset)? };
         let view_type = if desc.layers > 1 {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
@@ -155,26 +166,17 @@ impl Image {
                 )
             }
         };
-        let view = make_view(0, desc.mips)?;
-        let mip_views = if desc.mips > 1 {
-            (0..desc.mips)
-                .map(|m| make_view(m, 1))
-                .collect::<Result<Vec<_>, _>>()?
+        out.view = make_view(0, desc.mips)?;
+        if desc.mips > 1 {
+            for m in 0..desc.mips {
+                let v = make_view(m, 1)?;
+                out.mip_views.push(v);
+            }
         } else {
-            vec![view]
-        };
+            out.mip_views.push(out.view);
+        }
         gpu.name(image, desc.name);
-        Ok(Self {
-            image,
-            view,
-            mip_views,
-            format: desc.format,
-            extent: desc.extent,
-            layers: desc.layers,
-            mips: desc.mips,
-            aspect,
-            allocation: Some(allocation),
-        })
+        Ok(out)
     }
 
     /// Every mip and layer.
@@ -200,19 +202,24 @@ impl Image {
             height: (self.extent.height >> m).max(1),
         }
     }
+}
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        if let Some(a) = self.allocation.take() {
-            unsafe {
-                if self.mips > 1 {
-                    for v in &self.mip_views {
-                        gpu.device.destroy_image_view(*v, None);
-                    }
+impl Drop for Image {
+    fn drop(&mut self) {
+        let d = &self.shared.device;
+        unsafe {
+            for v in &self.mip_views {
+                if *v != self.view {
+                    d.destroy_image_view(*v, None);
                 }
-                gpu.device.destroy_image_view(self.view, None);
-                gpu.device.destroy_image(self.image, None);
             }
-            let _ = gpu.allocator.lock().unwrap().free(a);
+            if self.view != vk::ImageView::null() {
+                d.destroy_image_view(self.view, None);
+            }
+            d.destroy_image(self.image, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            let _ = self.shared.allocator.lock().unwrap().free(a);
         }
     }
 }
@@ -221,6 +228,7 @@ pub struct Buffer {
     pub buffer: vk::Buffer,
     pub size: u64,
     allocation: Option<Allocation>,
+    shared: Arc<Shared>,
 }
 
 impl Buffer {
@@ -239,8 +247,15 @@ impl Buffer {
             )
         }
         .with_context(|| format!("creating buffer {name}"))?;
+        let mut out = Self {
+            buffer,
+            size,
+            allocation: None,
+            shared: gpu.shared.clone(),
+        };
         let requirements = unsafe { gpu.device.get_buffer_memory_requirements(buffer) };
         let allocation = gpu
+            .shared
             .allocator
             .lock()
             .unwrap()
@@ -251,24 +266,13 @@ impl Buffer {
                 linear: true,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .with_context(|| format!("allocating {} MiB for buffer {name}", size >> 20));
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
-                unsafe { gpu.device.destroy_buffer(buffer, None) };
-                return Err(e);
-            }
-        };
-        unsafe {
-            gpu.device
-                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())?
-        };
+            .with_context(|| format!("allocating {} MiB for buffer {name}", size >> 20))?;
+        // SAFETY: the memory is bound to this object only, and freed after it.
+        let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
+        out.allocation = Some(allocation);
+        unsafe { gpu.device.bind_buffer_memory(buffer, memory, offset)? };
         gpu.name(buffer, name);
-        Ok(Self {
-            buffer,
-            size,
-            allocation: Some(allocation),
-        })
+        Ok(out)
     }
 
     /// A device-local buffer filled with `data` through a staging copy.
@@ -293,7 +297,7 @@ impl Buffer {
             MemoryLocation::CpuToGpu,
         )?;
         staging.write(0, data);
-        let result = gpu.run_once(|cmd| unsafe {
+        gpu.run_once(|cmd| unsafe {
             gpu.device.cmd_copy_buffer(
                 cmd,
                 staging.buffer,
@@ -309,9 +313,8 @@ impl Buffer {
                 vk::PipelineStageFlags2::ALL_COMMANDS,
                 vk::AccessFlags2::MEMORY_READ,
             );
-        });
-        staging.destroy(gpu);
-        result.map(|_| dst)
+        })?;
+        Ok(dst)
     }
 
     /// Host-visible bytes (CpuToGpu and GpuToCpu buffers only).
@@ -326,10 +329,45 @@ impl Buffer {
         slice[offset..offset + data.len()].copy_from_slice(data);
     }
 
-    pub fn destroy(&mut self, gpu: &Gpu) {
+    /// Host-visible bytes as `T`s (CpuToGpu and GpuToCpu buffers only).
+    pub fn read_pod<T: bytemuck::Pod>(&self) -> Vec<T> {
+        bytemuck::pod_collect_to_vec(self.mapped())
+    }
+
+    /// Writes `values` at `offset` bytes (host-visible buffers only).
+    pub fn write_pod<T: bytemuck::NoUninit>(&mut self, offset: usize, values: &[T]) {
+        self.write(offset, bytemuck::cast_slice(values));
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        unsafe { self.shared.device.destroy_buffer(self.buffer, None) };
         if let Some(a) = self.allocation.take() {
-            unsafe { gpu.device.destroy_buffer(self.buffer, None) };
-            let _ = gpu.allocator.lock().unwrap().free(a);
+            let _ = self.shared.allocator.lock().unwrap().free(a);
         }
+    }
+}
+
+/// A sampler that destroys itself when dropped.
+pub struct Sampler {
+    pub sampler: vk::Sampler,
+    shared: Arc<Shared>,
+}
+
+impl Sampler {
+    pub fn new(gpu: &Gpu, info: &vk::SamplerCreateInfo) -> Result<Self> {
+        let sampler =
+            unsafe { gpu.device.create_sampler(info, None) }.context("creating a sampler")?;
+        Ok(Self {
+            sampler,
+            shared: gpu.shared.clone(),
+        })
+    }
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        unsafe { self.shared.device.destroy_sampler(self.sampler, None) };
     }
 }

@@ -4,8 +4,10 @@
 #![allow(dead_code)]
 
 use glam::{DVec3, Vec3, Vec4};
-use isr::renderer::{FrameStats, Readback, RenderSettings, Renderer};
+use isr::readback::Readback;
+use isr::renderer::{FrameStats, Renderer};
 use isr::scene::{Camera, Scene, SpotLight};
+use isr::settings::RenderSettings;
 use isr::vk::{Gpu, GpuOptions, Validation};
 
 /// A device with the validation layer loaded when it is installed.
@@ -45,7 +47,7 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) 
     let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
     let stats = r.render_frames(frames, |_| {}).expect("rendering");
     let readback = r.readback().expect("readback");
-    let uniforms = *r.uniforms();
+    let uniforms = r.frame_uniforms();
     drop(r);
     assert_validation_clean(gpu);
     Rendered {
@@ -110,7 +112,7 @@ pub fn floor_scene(light: SpotLight, camera: Camera, half: f32, albedo: f32) -> 
     s
 }
 
-/// The direct radiance ALGORITHM.md section 2 gives for an unshadowed
+/// The direct radiance docs/algorithm.md section 2 gives for an unshadowed
 /// Lambertian point: rho/pi * I(w) * max(0, n.l) / r^2, per channel, in f64.
 pub fn expected_direct(light: &SpotLight, albedo: Vec4, p: DVec3, n: DVec3) -> DVec3 {
     let to_light = light.position.as_dvec3() - p;
@@ -125,9 +127,10 @@ pub fn bin() -> std::process::Command {
 
 pub struct RenderedMultires {
     pub readback: Readback,
-    pub multires: isr::renderer::MultiresReadback,
+    pub multires: isr::readback::MultiresReadback,
     pub stats: FrameStats,
     pub uniforms: isr::gpu_types::FrameUniforms,
+    pub run: isr::gpu_types::RunUniforms,
     pub total_area: u64,
 }
 
@@ -140,14 +143,8 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
         .readback_multires()
         .expect("readback")
         .expect("a multiresolution method");
-    let uniforms = *r.uniforms();
-    let total_area = r
-        .gather_method
-        .as_ref()
-        .unwrap()
-        .multires
-        .buffer
-        .total_area();
+    let uniforms = r.frame_uniforms();
+    let total_area = r.multires().expect("a multiresolution method").total_area();
     drop(r);
     assert_validation_clean(gpu);
     RenderedMultires {
@@ -155,12 +152,13 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
         multires,
         stats,
         uniforms,
+        run: isr::frame::uniforms::run_uniforms(settings),
         total_area,
     }
 }
 
 /// The regular VPLs of RSM quadtree level `k` as (position, normal, flux, area).
-pub fn vpls_at(m: &isr::renderer::MultiresReadback, k: usize) -> Vec<(DVec3, DVec3, DVec3, f64)> {
+pub fn vpls_at(m: &isr::readback::MultiresReadback, k: usize) -> Vec<(DVec3, DVec3, DVec3, f64)> {
     let [pos, nrm, flux] = &m.rsm_tree[k];
     pos.iter()
         .zip(nrm)
@@ -173,7 +171,7 @@ pub fn vpls_at(m: &isr::renderer::MultiresReadback, k: usize) -> Vec<(DVec3, DVe
         .collect()
 }
 
-/// ALGORITHM.md section 2 in f64: sum over patches of
+/// docs/algorithm.md section 2 in f64: sum over patches of
 /// Phi_j cos_i cos_j / (pi d^2 + A_j), the irradiance at (x, n).
 pub fn cpu_gather(vpls: &[(DVec3, DVec3, DVec3, f64)], x: DVec3, n: DVec3) -> DVec3 {
     let mut e = DVec3::ZERO;

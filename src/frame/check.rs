@@ -1,0 +1,181 @@
+//! Settings checked against the device before anything is allocated, each
+//! failure with a message that says what to change.
+
+use super::targets::target_list;
+use crate::settings::{Method, RenderSettings, MAX_LEVELS};
+use crate::vk::resources::texel_bytes;
+use crate::vk::Gpu;
+use anyhow::{bail, Result};
+use ash::vk;
+
+/// Checks `s` against `gpu`'s limits and memory.
+pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
+    check_ranges(s)?;
+    let l = gpu.limits();
+    let max_w = l.max_image_dimension2_d.min(l.max_framebuffer_width);
+    let max_h = l.max_image_dimension2_d.min(l.max_framebuffer_height);
+    if s.width > max_w || s.height > max_h {
+        bail!(
+            "resolution {}x{} exceeds what {} can render ({max_w}x{max_h}); choose a smaller --width/--height",
+            s.width,
+            s.height,
+            gpu.info.name
+        );
+    }
+    let r = s.rsm_resolution;
+    if r > max_w.min(max_h) {
+        bail!(
+            "--rsm {r} exceeds this device's image limit of {}",
+            max_w.min(max_h)
+        );
+    }
+    let needed = memory_estimate(s);
+    let props = unsafe {
+        gpu.instance
+            .get_physical_device_memory_properties(gpu.physical)
+    };
+    let heap = props.memory_heaps[..props.memory_heap_count as usize]
+        .iter()
+        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+        .unwrap_or(0);
+    if heap > 0 && needed > heap / 10 * 9 {
+        bail!(
+            "resolution {}x{} with --rsm {r} needs about {} MiB of GPU memory; the device has {} MiB. Choose a smaller resolution",
+            s.width,
+            s.height,
+            needed >> 20,
+            heap >> 20
+        );
+    }
+    Ok(())
+}
+
+/// Bytes of GPU memory the targets, readback buffers and the method's
+/// hierarchy take.
+pub fn memory_estimate(s: &RenderSettings) -> u64 {
+    let pixels = s.width as u64 * s.height as u64;
+    let targets: u64 = target_list()
+        .iter()
+        .map(|t| {
+            // RSM color images carry the quadtree: a mip chain, 4/3 the texels.
+            let texels = if t.at_rsm_resolution {
+                (s.rsm_resolution as u64).pow(2) * 4 / 3
+            } else {
+                pixels
+            };
+            texels * texel_bytes(t.format)
+        })
+        .sum();
+    // Readback buffers for the largest layers.
+    let readback = pixels * 16 * 2;
+    targets
+        + readback
+        + if s.method.uses_multires() {
+            multires_bytes(s)
+        } else {
+            0
+        }
+}
+
+/// GPU memory of the multiresolution buffer: (L + 1) layers of illumination
+/// (RGBA32F), evaluation counts (R32F) and stencil, plus five geometry mip
+/// chains (four RGBA32F, one R32UI).
+fn multires_bytes(s: &RenderSettings) -> u64 {
+    let pixels = s.width as u64 * s.height as u64;
+    let layers = s.levels().min(MAX_LEVELS) as u64 + 1;
+    layers * pixels * (16 + 4 + 4) + pixels * 4 / 3 * (4 * 16 + 4)
+}
+
+/// The checks that need no device: sizes, powers of two, ranges.
+pub fn check_ranges(s: &RenderSettings) -> Result<()> {
+    if s.width == 0 || s.height == 0 {
+        bail!(
+            "resolution {}x{} is empty: width and height must be at least 1",
+            s.width,
+            s.height
+        );
+    }
+    let r = s.rsm_resolution;
+    if !r.is_power_of_two() || r < 16 {
+        bail!("--rsm {r}: the RSM resolution must be a power of two of at least 16 (it is the root of a quadtree)");
+    }
+    if !(s.exposure.is_finite() && s.exposure >= 0.0) {
+        bail!("--exposure must be a finite non-negative number");
+    }
+    if !(s.splat_threshold.is_finite() && s.splat_threshold >= 0.0) {
+        bail!("--splat-threshold must be a finite non-negative irradiance (W/m^2)");
+    }
+    if s.method == Method::MultiresSplat && !s.multires.stencil {
+        bail!("--stencil off measures the stenciled gathers; multires-splat always splats through the stencil");
+    }
+    if !s.method.uses_regular_vpls() {
+        return Ok(());
+    }
+    let side = (s.vpls as f64).sqrt() as u32;
+    if s.vpls == 0 || side * side != s.vpls || !side.is_power_of_two() {
+        bail!(
+            "--vpls {}: the number of regular VPLs must be a power of 4 (1, 4, 16, ..., 4096, ...)",
+            s.vpls
+        );
+    }
+    if side > r {
+        bail!(
+            "--vpls {} needs more RSM texels than --rsm {r} has ({} at most)",
+            s.vpls,
+            r as u64 * r as u64
+        );
+    }
+    let levels = s.levels();
+    if levels == 0 || levels >= MAX_LEVELS || s.width >> levels == 0 || s.height >> levels == 0 {
+        let what = if s.multires.levels.is_some() {
+            format!("--levels {levels}")
+        } else {
+            format!(
+                "the default --levels ({levels}) for {}x{}",
+                s.width, s.height
+            )
+        };
+        bail!(
+            "{what}: the coarsest level must be at least 1 and its texels ({0}x{0} pixels) no larger than the image; \
+             choose a larger --width/--height or a smaller --levels",
+            1u64 << levels.min(63)
+        );
+    }
+    let m = &s.multires;
+    let lt = &s.light_tree;
+    if s.method == Method::Isr && (!lt.isr_base.is_power_of_two() || lt.isr_base > r) {
+        bail!(
+            "--isr-base {}: the base must be a power of 2 no larger than --rsm {r}",
+            lt.isr_base
+        );
+    }
+    let top = r.ilog2();
+    let max_depth = s.hisr_max_depth();
+    if s.method == Method::Hisr && (max_depth > top || lt.start_level > max_depth) {
+        bail!(
+            "--start-level {} and --max-depth {max_depth} must satisfy start <= max <= log2(--rsm) = {top}",
+            lt.start_level
+        );
+    }
+    if !(lt.tau > 0.0 && lt.tau < 1.0) {
+        bail!(
+            "--tau {}: tau is a fraction of the light's intensity, strictly between 0 and 1",
+            lt.tau
+        );
+    }
+    if !(lt.depth_threshold.is_finite()
+        && lt.depth_threshold >= 0.0
+        && (0.0..=180.0).contains(&lt.normal_threshold_deg))
+    {
+        bail!("--light-depth-threshold must be >= 0 and --light-normal-threshold within 0..=180 degrees");
+    }
+    let depth_ok = m.depth_threshold.is_finite() && m.depth_threshold >= 0.0;
+    let normal_ok =
+        m.normal_threshold_deg.is_finite() && (0.0..=180.0).contains(&m.normal_threshold_deg);
+    if !(depth_ok && normal_ok) {
+        bail!("--depth-threshold must be >= 0 and --normal-threshold within 0..=180 degrees");
+    }
+    Ok(())
+}
