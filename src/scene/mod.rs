@@ -6,6 +6,7 @@ pub mod animation;
 pub mod cornell;
 pub mod export;
 pub mod gltf_load;
+pub mod motion;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
