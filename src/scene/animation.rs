@@ -45,8 +45,20 @@ pub enum Interpolation {
     CubicSpline,
 }
 
+impl Property {
+    /// The glTF `target.path`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Translation => "translation",
+            Self::Rotation => "rotation",
+            Self::Scale => "scale",
+        }
+    }
+}
+
 impl Interpolation {
-    fn name(self) -> &'static str {
+    /// The glTF `sampler.interpolation`.
+    pub fn name(self) -> &'static str {
         match self {
             Self::Step => "STEP",
             Self::Linear => "LINEAR",
