@@ -395,6 +395,12 @@ pub fn from_gltf(
             "{skins} skin(s) ignored: skinned meshes are drawn unskinned at their node"
         ));
     }
+    if doc.animations().len() == 0 {
+        return Ok(None);
+    }
+    // The JSON (not the buffers) is copied once to check what the accessors
+    // below would unwrap.
+    check_references(&doc.clone().into_json())?;
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut channels = Vec::new();
     for anim in doc.animations() {
@@ -685,53 +691,55 @@ fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&
 }
 
 /// Names the animation and channel when the glTF crate rejected a file for an
-/// animation's reference (sampler, target node or path, interpolation,
-/// accessor); `None` when the problem lies elsewhere.
+/// animation's reference; `None` when the problem lies elsewhere.
 pub fn explain_invalid(bytes: &[u8]) -> Option<anyhow::Error> {
-    use gltf::json::validation::Checked;
     let root = gltf::Gltf::from_slice_without_validation(bytes)
         .ok()?
         .document
         .into_json();
+    check_references(&root).err()
+}
+
+/// Every channel's sampler, target node and path, and its sampler's
+/// interpolation and accessors exist. The glTF crate validates samplers but
+/// not channel targets, and its accessors unwrap.
+fn check_references(root: &gltf::json::Root) -> Result<()> {
+    use gltf::json::validation::Checked;
     for (a, anim) in root.animations.iter().enumerate() {
         for (c, ch) in anim.channels.iter().enumerate() {
             let label = label(a, anim.name.as_deref(), c);
             let s = ch.sampler.value();
             let Some(sampler) = anim.samplers.get(s) else {
-                return Some(anyhow!(
+                bail!(
                     "{label} uses sampler {s}, which does not exist (the animation has {} samplers)",
                     anim.samplers.len()
-                ));
+                );
             };
             let node = ch.target.node.value();
             if node >= root.nodes.len() {
-                return Some(anyhow!(
+                bail!(
                     "{label} targets node {node}, which does not exist (the file has {} nodes)",
                     root.nodes.len()
-                ));
+                );
             }
             if let Checked::Invalid = ch.target.path {
-                return Some(anyhow!(
-                    "{label}: the target path is not translation, rotation, scale or weights"
-                ));
+                bail!("{label}: the target path is not translation, rotation, scale or weights");
             }
             if let Checked::Invalid = sampler.interpolation {
-                return Some(anyhow!(
-                    "{label}: sampler {s}'s interpolation is not STEP, LINEAR or CUBICSPLINE"
-                ));
+                bail!("{label}: sampler {s}'s interpolation is not STEP, LINEAR or CUBICSPLINE");
             }
             for (what, i) in [("input", sampler.input), ("output", sampler.output)] {
                 if i.value() >= root.accessors.len() {
-                    return Some(anyhow!(
+                    bail!(
                         "{label}: the {what} accessor {} of sampler {s} does not exist (the file has {} accessors)",
                         i.value(),
                         root.accessors.len()
-                    ));
+                    );
                 }
             }
         }
     }
-    None
+    Ok(())
 }
 
 #[cfg(test)]
