@@ -62,6 +62,32 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
         (file.camera.yfov, file.camera.znear),
         (builtin.camera.yfov, builtin.camera.znear)
     );
+    // The light's sweep: the same animation, and at 0 s the light is at rest.
+    assert_eq!(file.animation_duration(), builtin.animation_duration());
+    assert!(builtin.animation_duration().is_some());
+    let rest = builtin.state_at(0.0).light;
+    assert!(
+        rest.position.abs_diff_eq(m.position, 1e-6)
+            && rest.direction.abs_diff_eq(m.direction, 1e-6)
+    );
+    for t in [-1.0, 0.0, 0.4, 1.0, 1.7, 2.5, 3.0, 3.9, 4.0, 7.0] {
+        let (a, b) = (file.state_at(t), builtin.state_at(t));
+        assert!(
+            a.light.position.abs_diff_eq(b.light.position, 1e-6)
+                && a.light.direction.abs_diff_eq(b.light.direction, 1e-6),
+            "light at {t} s: {:?} vs {:?}",
+            a.light,
+            b.light
+        );
+        assert!(a
+            .camera
+            .world_from_camera
+            .abs_diff_eq(b.camera.world_from_camera, 1e-5));
+    }
+    assert!(
+        builtin.state_at(1.0).light.direction.x > 0.5,
+        "the light sweeps"
+    );
 }
 
 fn load_json(doc: &Value, name: &str) -> (Scene, std::path::PathBuf) {
@@ -102,6 +128,8 @@ fn node_hierarchy_transforms_compose() {
 #[test]
 fn missing_camera_and_light_get_defaults_with_warnings() {
     let mut doc = cornell_json();
+    // The light's animation targets the light node removed below.
+    doc.as_object_mut().unwrap().remove("animations");
     let nodes = doc["nodes"].as_array_mut().unwrap();
     nodes.retain(|n| n.get("camera").is_none() && n.get("extensions").is_none());
     let n = nodes.len();

@@ -1,19 +1,50 @@
 //! Writes a [`Scene`] as a self-contained glTF 2.0 file (buffers embedded as
 //! base64). Used to produce `assets/cornell.gltf` from the built-in scene.
 
+use super::animation::{Animation, Local, Parent, Property};
 use super::Scene;
 use anyhow::{bail, Result};
 use base64::Engine as _;
 use glam::{Mat4, Vec3};
 use serde_json::{json, Value};
 
-fn push_aligned(bin: &mut Vec<u8>, data: &[u8]) -> usize {
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
+/// The one buffer, its views and the accessors, as they are written.
+#[derive(Default)]
+struct Bin {
+    bytes: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Bin {
+    /// Appends `data` (4-byte aligned) with a view and an accessor; `extra`
+    /// fields (min, max) go into the accessor. Returns the accessor's index.
+    fn add(&mut self, data: &[u8], count: usize, ty: &str, comp: u32, extra: Value) -> usize {
+        while !self.bytes.len().is_multiple_of(4) {
+            self.bytes.push(0);
+        }
+        let offset = self.bytes.len();
+        self.bytes.extend_from_slice(data);
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": data.len()}));
+        let mut acc = json!({"bufferView": self.views.len() - 1, "componentType": comp, "count": count, "type": ty});
+        if let (Value::Object(a), Value::Object(e)) = (&mut acc, extra) {
+            a.extend(e);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
     }
-    let offset = bin.len();
-    bin.extend_from_slice(data);
-    offset
+
+    fn floats(
+        &mut self,
+        f: impl Iterator<Item = f32>,
+        count: usize,
+        ty: &str,
+        extra: Value,
+    ) -> usize {
+        let data: Vec<u8> = f.flat_map(f32::to_le_bytes).collect();
+        self.add(&data, count, ty, 5126, extra)
+    }
 }
 
 /// The node matrix that makes local -Z point along `dir` from `pos`.
@@ -30,52 +61,29 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
     if !scene.textures.is_empty() {
         bail!("exporting textured scenes is not supported");
     }
-    let mut bin = Vec::new();
-    let mut views = Vec::new();
-    let mut accessors = Vec::new();
+    let mut bin = Bin::default();
     let mut meshes = Vec::new();
-    let mut add = |bin: &mut Vec<u8>,
-                   bytes: &[u8],
-                   count: usize,
-                   ty: &str,
-                   comp: u32,
-                   extra: Value| {
-        let offset = push_aligned(bin, bytes);
-        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
-        let mut acc = json!({"bufferView": views.len() - 1, "componentType": comp, "count": count, "type": ty});
-        if let (Value::Object(a), Value::Object(e)) = (&mut acc, extra) {
-            a.extend(e);
-        }
-        accessors.push(acc);
-        accessors.len() - 1
-    };
     for m in &scene.meshes {
-        let pos: Vec<f32> = m.vertices.iter().flat_map(|v| v.position).collect();
-        let nrm: Vec<f32> = m.vertices.iter().flat_map(|v| v.normal).collect();
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for v in &m.vertices {
             lo = lo.min(Vec3::from(v.position));
             hi = hi.max(Vec3::from(v.position));
         }
-        let bytes = |f: &[f32]| f.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-        let p = add(
-            &mut bin,
-            &bytes(&pos),
-            m.vertices.len(),
+        let count = m.vertices.len();
+        let p = bin.floats(
+            m.vertices.iter().flat_map(|v| v.position),
+            count,
             "VEC3",
-            5126,
             json!({"min": lo.to_array(), "max": hi.to_array()}),
         );
-        let n = add(
-            &mut bin,
-            &bytes(&nrm),
-            m.vertices.len(),
+        let n = bin.floats(
+            m.vertices.iter().flat_map(|v| v.normal),
+            count,
             "VEC3",
-            5126,
             json!({}),
         );
         let idx: Vec<u8> = m.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let i = add(&mut bin, &idx, m.indices.len(), "SCALAR", 5125, json!({}));
+        let i = bin.add(&idx, m.indices.len(), "SCALAR", 5125, json!({}));
         meshes.push(json!({"name": m.name, "primitives": [{
             "attributes": {"POSITION": p, "NORMAL": n}, "indices": i, "material": m.material}]}));
     }
@@ -90,31 +98,135 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
         .iter()
         .map(|i| json!({"mesh": i.mesh, "matrix": i.world_from_object.to_cols_array()}))
         .collect();
+    let mut roots: Vec<usize> = (0..nodes.len()).collect();
+    let mut animations = vec![];
+    let (mut light_at, mut camera_at) = (None, None);
+    if let Some(a) = &scene.animation {
+        let (anim, l, c) = animation_json(a, &mut nodes, &mut roots, &mut bin);
+        animations.push(anim);
+        (light_at, camera_at) = (l, c);
+    }
     let l = &scene.light;
-    nodes.push(
-        json!({"name": "light", "matrix": looking_along(l.position, l.direction).to_cols_array(),
-        "extensions": {"KHR_lights_punctual": {"light": 0}}}),
+    let mut place = |at: Option<usize>, fields: Value, matrix: Mat4| match at {
+        // On the animated node that moves it.
+        Some(id) => {
+            if let (Value::Object(node), Value::Object(f)) = (&mut nodes[id], fields) {
+                node.extend(f);
+            }
+        }
+        None => {
+            let mut node = fields;
+            node["matrix"] = json!(matrix.to_cols_array());
+            nodes.push(node);
+            roots.push(nodes.len() - 1);
+        }
+    };
+    place(
+        light_at,
+        json!({"name": "light", "extensions": {"KHR_lights_punctual": {"light": 0}}}),
+        looking_along(l.position, l.direction),
     );
-    nodes.push(json!({"name": "camera", "camera": 0, "matrix": scene.camera.world_from_camera.to_cols_array()}));
+    place(
+        camera_at,
+        json!({"name": "camera", "camera": 0}),
+        scene.camera.world_from_camera,
+    );
     let mut light = json!({"type": "spot", "color": l.color.to_array(), "intensity": l.intensity,
         "spot": {"innerConeAngle": l.inner_cone, "outerConeAngle": l.outer_cone}});
     if let Some(r) = l.range {
         light["range"] = json!(r);
     }
-    let doc = json!({
+    let mut doc = json!({
         "asset": {"version": "2.0", "generator": "isr export-builtin"},
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": [light]}},
         "scene": 0,
-        "scenes": [{"name": scene.name, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "scenes": [{"name": scene.name, "nodes": roots}],
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
         "cameras": [{"type": "perspective", "perspective": {"yfov": scene.camera.yfov, "znear": scene.camera.znear}}],
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{"byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}",
-            base64::engine::general_purpose::STANDARD.encode(&bin))}],
+        "accessors": bin.accessors,
+        "bufferViews": bin.views,
+        "buffers": [{"byteLength": bin.bytes.len(), "uri": format!("data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&bin.bytes))}],
     });
+    if !animations.is_empty() {
+        doc["animations"] = json!(animations);
+    }
     Ok(serde_json::to_string_pretty(&doc)?)
+}
+
+/// Writes the animation's nodes (TRS where animated) and one glTF animation
+/// with a sampler per channel. Instances the animation moves become children
+/// without a transform of their node (`nodes[i]` is instance `i` on entry).
+/// Returns the animation and the nodes that carry the light and the camera
+/// when it moves them.
+fn animation_json(
+    a: &Animation,
+    nodes: &mut Vec<Value>,
+    roots: &mut Vec<usize>,
+    bin: &mut Bin,
+) -> (Value, Option<usize>, Option<usize>) {
+    let instances = nodes.len();
+    let mut ids = Vec::with_capacity(a.nodes.len());
+    let mut children: Vec<(usize, usize)> = vec![];
+    for n in &a.nodes {
+        nodes.push(match n.local {
+            Local::Fixed(m) => json!({"matrix": m.to_cols_array()}),
+            Local::Animated(t) => json!({"translation": t.translation.to_array(),
+                "rotation": t.rotation.to_array(), "scale": t.scale.to_array()}),
+        });
+        let id = nodes.len() - 1;
+        ids.push(id);
+        match n.parent {
+            Parent::Node(p) => children.push((ids[p], id)),
+            Parent::Fixed(m) if m == Mat4::IDENTITY => roots.push(id),
+            Parent::Fixed(m) => {
+                nodes.push(json!({"matrix": m.to_cols_array(), "children": [id]}));
+                roots.push(nodes.len() - 1);
+            }
+        }
+    }
+    for &(instance, n) in &a.instances {
+        // An index past the scene's instances moves nothing.
+        if let (true, Value::Object(node)) = (instance < instances, &mut nodes[instance]) {
+            node.remove("matrix");
+            roots.retain(|&r| r != instance);
+            children.push((ids[n], instance));
+        }
+    }
+    for (parent, child) in children {
+        match nodes[parent].get_mut("children") {
+            Some(Value::Array(c)) => c.push(json!(child)),
+            _ => nodes[parent]["children"] = json!([child]),
+        }
+    }
+    let mut samplers = vec![];
+    let mut channels = vec![];
+    for c in &a.channels {
+        let (lo, hi) = (c.times[0], c.times[c.times.len() - 1]);
+        let input = bin.floats(
+            c.times.iter().copied(),
+            c.times.len(),
+            "SCALAR",
+            json!({"min": [lo], "max": [hi]}),
+        );
+        let (width, ty) = match c.property {
+            Property::Rotation => (4, "VEC4"),
+            _ => (3, "VEC3"),
+        };
+        let values = c
+            .values
+            .iter()
+            .flat_map(|v| v.to_array().into_iter().take(width));
+        let output = bin.floats(values, c.values.len(), ty, json!({}));
+        samplers.push(
+            json!({"input": input, "output": output, "interpolation": c.interpolation.name()}),
+        );
+        channels.push(json!({"sampler": samplers.len() - 1,
+            "target": {"node": ids[c.node], "path": c.property.name()}}));
+    }
+    let anim = json!({"name": "animation", "samplers": samplers, "channels": channels});
+    (anim, a.light.map(|n| ids[n]), a.camera.map(|n| ids[n]))
 }

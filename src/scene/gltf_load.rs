@@ -40,8 +40,10 @@ pub fn load(path: &Path) -> Result<Scene> {
 }
 
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
-    let gltf =
-        gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("not a valid glTF 2.0 file: {e}"))?;
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+        super::animation::explain_invalid(bytes)
+            .unwrap_or_else(|| anyhow!("not a valid glTF 2.0 file: {e}"))
+    })?;
     let doc = &gltf.document;
     for ext in doc.extensions_required() {
         if !SUPPORTED_REQUIRED.contains(&ext) {
@@ -67,6 +69,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
     let mut texture_ids: HashMap<usize, usize> = HashMap::new();
     let mut light: Option<SpotLight> = None;
     let mut camera: Option<(usize, Camera)> = None;
+    let mut bound = super::animation::NodeBindings::default();
 
     let mut stack: Vec<(gltf::Node, Mat4, usize)> =
         scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
@@ -118,6 +121,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
                         mesh: id,
                         world_from_object: world,
                     });
+                    bound.instances.push(node.index());
                 }
             }
         }
@@ -125,6 +129,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
             let spot = read_light(&l, world)?;
             if light.is_none() {
                 light = Some(spot);
+                bound.light = Some(node.index());
             } else {
                 warnings.push(format!(
                     "light {} ignored: isr renders one light per frame (the first spot light is used)",
@@ -146,6 +151,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
                     // "The first perspective camera": lowest camera index.
                     if camera.as_ref().is_none_or(|(i, _)| c.index() < *i) {
                         camera = Some((c.index(), cam));
+                        bound.camera = Some(node.index());
                     }
                 }
                 gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
@@ -180,6 +186,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene> {
             );
         }
     }
+    out.animation = super::animation::from_gltf(doc, &buffers, &bound, &mut warnings)?;
     out.warnings = warnings;
     Ok(out)
 }

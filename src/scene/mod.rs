@@ -2,9 +2,11 @@
 //! light and one perspective camera. Loaded from glTF (`gltf_load`), built in
 //! (`cornell`), or assembled by code (tests) with the helpers below.
 
+pub mod animation;
 pub mod cornell;
 pub mod export;
 pub mod gltf_load;
+pub mod motion;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -174,6 +176,8 @@ pub struct Scene {
     pub camera: Camera,
     /// Things the loader skipped or assumed, printed by the CLI.
     pub warnings: Vec<String>,
+    /// What moves over time; `None` for a still scene (and scenes built by code).
+    pub animation: Option<animation::Animation>,
 }
 
 impl Scene {
@@ -188,6 +192,7 @@ impl Scene {
             light,
             camera,
             warnings: vec![],
+            animation: None,
         }
     }
 
@@ -251,6 +256,21 @@ impl Scene {
             light: self.light,
             instance_transforms: self.instances.iter().map(|i| i.world_from_object).collect(),
         }
+    }
+
+    /// The state at animation time `t` seconds: `rest_state()` with what the
+    /// animation moves moved (the same for every `t` without animation).
+    pub fn state_at(&self, t: f32) -> FrameState {
+        let mut state = self.rest_state();
+        if let Some(a) = &self.animation {
+            a.apply(t, &mut state);
+        }
+        state
+    }
+
+    /// The latest keyframe time, or `None` for a still scene.
+    pub fn animation_duration(&self) -> Option<f32> {
+        self.animation.as_ref().and_then(|a| a.duration())
     }
 
     pub fn triangle_count(&self) -> usize {
