@@ -147,6 +147,63 @@ struct RenderArgs {
     /// map of the light patches evaluated per pixel. Repeatable.
     #[arg(long, value_enum)]
     debug_view: Vec<DebugView>,
+    /// Animation time in seconds: the scene's glTF animations (and the
+    /// --orbit-* motion) at this time. With --sequence, the first frame's time.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    time: f32,
+    /// Write --frames frames at times --time + k / --fps into this folder
+    /// (frame_0000.exr, frame_0000.png, ..., timings.json) instead of timing
+    /// one frame --frames times.
+    #[arg(long)]
+    sequence: Option<PathBuf>,
+    /// Frames per second of a --sequence.
+    #[arg(long, default_value_t = 30.0)]
+    fps: f32,
+    /// Circle the light about the scene's vertical axis through its initial
+    /// position, once per PERIOD seconds, still aimed at the same point.
+    #[arg(long, value_name = "PERIOD")]
+    orbit_light: Option<f32>,
+    /// The same for the camera.
+    #[arg(long, value_name = "PERIOD")]
+    orbit_camera: Option<f32>,
+}
+
+impl RenderArgs {
+    /// The scene's frame state at animation time `t`, with the built-in motion.
+    fn state_at(&self, scene: &scene::Scene, t: f32) -> scene::FrameState {
+        let mut state = scene.state_at(t);
+        let pivot = scene::motion::pivot(scene);
+        if let Some(period) = self.orbit_light {
+            scene::motion::orbit_light(&mut state, pivot, period, t);
+        }
+        if let Some(period) = self.orbit_camera {
+            scene::motion::orbit_camera(&mut state, pivot, period, t);
+        }
+        state
+    }
+
+    fn check_motion(&self) -> Result<()> {
+        if !self.time.is_finite() {
+            bail!(
+                "--time {}: the animation time must be a finite number of seconds",
+                self.time
+            );
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            bail!("--fps {}: frames per second must be positive", self.fps);
+        }
+        for (name, p) in [
+            ("--orbit-light", self.orbit_light),
+            ("--orbit-camera", self.orbit_camera),
+        ] {
+            if let Some(p) = p {
+                if !(p.is_finite() && p > 0.0) {
+                    bail!("{name} {p}: the period must be a positive number of seconds");
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -229,6 +286,7 @@ fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
             wall_ms_median: ms,
             patches_per_level: None,
             light_patches: None,
+            time: None,
         };
         report::write_json(path, &r)?;
         println!("wrote {}", path.display());
@@ -313,7 +371,73 @@ fn devices() -> Result<()> {
     Ok(())
 }
 
+/// `--sequence DIR`: frame k at time `--time + k / --fps`, each written as
+/// EXR and PNG, and every frame's per-pass times in `DIR/timings.json`.
+fn sequence(
+    args: &RenderArgs,
+    scene: &scene::Scene,
+    gpu: &Gpu,
+    renderer: &mut Renderer,
+    dir: &std::path::Path,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let started = std::time::Instant::now();
+    let mut reports = Vec::new();
+    for k in 0..args.frames {
+        let t = args.time + k as f32 / args.fps;
+        renderer.update(&args.state_at(scene, t))?;
+        // Each frame is its own run of one frame: its images are read back
+        // before the next one changes the scene.
+        let stats = renderer.render_frames(1, |_| {})?;
+        let result = renderer.readback()?;
+        let exr = dir.join(format!("frame_{k:04}.exr"));
+        let png = dir.join(format!("frame_{k:04}.png"));
+        output::write_exr(&exr, &result)?;
+        output::write_png(&png, result.width, result.height, &result.display)?;
+        let mut r = report::build(
+            &report::RunInfo {
+                device: &gpu.info.name,
+                driver: &gpu.info.driver,
+                scene: &scene.name,
+                width: args.width,
+                height: args.height,
+                rsm: args.rsm,
+                method: args.method.name(),
+            },
+            &stats,
+        );
+        r.time = Some(t);
+        reports.push(r);
+        let p = crate::renderer::FrameProgress {
+            frame: k + 1,
+            frames: args.frames,
+            submission: 1,
+            submissions: 1,
+        };
+        eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
+    }
+    eprintln!();
+    let path = dir.join("timings.json");
+    let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": reports }))?;
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    println!(
+        "wrote {} frames ({}/frame_0000.exr ...) and {}",
+        args.frames,
+        dir.display(),
+        path.display()
+    );
+    let messages = gpu.take_validation_messages();
+    if !messages.is_empty() {
+        bail!(
+            "the validation layer reported {} message(s) (printed above)",
+            messages.len()
+        );
+    }
+    Ok(())
+}
+
 fn render(args: RenderArgs) -> Result<()> {
+    args.check_motion()?;
     let scene = match &args.scene {
         Some(path) => scene::gltf_load::load(path)?,
         None => scene::cornell::cornell_box(),
@@ -322,7 +446,15 @@ fn render(args: RenderArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     if args.method == Method::Pathtrace {
-        return pathtrace(&args, &scene);
+        // The CPU reference renders the scene posed at --time.
+        let state = args.state_at(&scene, args.time);
+        let mut posed = scene.clone();
+        posed.camera = state.camera;
+        posed.light = state.light;
+        for (inst, m) in posed.instances.iter_mut().zip(&state.instance_transforms) {
+            inst.world_from_object = *m;
+        }
+        return pathtrace(&args, &posed);
     }
     if scene.light.outer_cone > crate::view::MAX_RSM_HALF_FOV {
         eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");
@@ -373,6 +505,10 @@ fn render(args: RenderArgs) -> Result<()> {
         gpu.info.name
     );
     let mut renderer = Renderer::new(&gpu, &scene, &settings)?;
+    if let Some(dir) = &args.sequence {
+        return sequence(&args, &scene, &gpu, &mut renderer, dir);
+    }
+    renderer.update(&args.state_at(&scene, args.time))?;
     let frames = args.frames;
     let started = std::time::Instant::now();
     let stats = renderer.render_frames(frames, |p| {

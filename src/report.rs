@@ -42,6 +42,9 @@ pub struct TimingReport {
     /// Light patches evaluated per eye-space patch (and chosen by ISR).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub light_patches: Option<crate::debug_view::LightPatchStats>,
+    /// Animation time of the frame (sequences).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<f32>,
 }
 
 pub fn median(values: &[f64]) -> Option<f64> {
@@ -106,6 +109,7 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
         patches_per_level: stats.patches_per_level.clone(),
         light_patches: None,
+        time: None,
     }
 }
 

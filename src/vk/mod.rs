@@ -2,6 +2,7 @@
 
 pub mod barrier;
 pub mod context;
+pub mod descriptors;
 pub mod pipeline;
 pub mod profiler;
 pub mod reflect;
