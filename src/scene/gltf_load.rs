@@ -957,9 +957,20 @@ pub fn fitted_light(lo: Vec3, hi: Vec3) -> SpotLight {
 /// A camera on +Z of the bounds, framing them with a 45 degree vertical fov.
 /// Computed in f64 so that it stays finite for any finite bounds.
 pub fn fitted_camera(lo: Vec3, hi: Vec3) -> Camera {
-    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    // Bounds beyond f32::MAX / 8 (refused by the loader long before, see
+    // `Limits::coordinate`) are clamped so the eye stays a finite f32.
+    let m = f32::MAX as f64 / 8.0;
+    let clamp = |v: Vec3| {
+        v.as_dvec3()
+            .clamp(glam::DVec3::splat(-m), glam::DVec3::splat(m))
+    };
+    let (lo, hi) = (clamp(lo), clamp(hi));
     let center = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    // At least a millionth of the distance from the origin, so that the eye
+    // is a different f32 from the centre even for a point far out.
+    let radius = ((hi - lo).length() * 0.5)
+        .max(1e-3)
+        .max(center.abs().max_element() * 1e-6);
     let yfov = 45f64.to_radians();
     let distance = radius / (yfov * 0.5).sin();
     let eye = center + glam::DVec3::Z * distance;
