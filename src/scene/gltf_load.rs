@@ -237,14 +237,18 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>)>
     } else {
         bytes
     };
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| match e {
+    let invalid = |e| match e {
         gltf::Error::Binary(e) => anyhow!("not a valid GLB file: {e}"),
         e => anyhow!("not a valid glTF 2.0 file: {e}"),
-    })?;
+    };
+    // Validation after `check_json`: gltf-json's own validation indexes the
+    // POSITION accessor before checking that it exists (a panic).
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
     let gltf::Gltf { document, blob } = gltf;
     let root = document.into_json();
     check_json(&root)?;
-    Ok((gltf::Document::from_json_without_validation(root), blob))
+    let document = gltf::Document::from_json(root).map_err(invalid)?;
+    Ok((document, blob))
 }
 
 /// The GLB header (magic, version 2, total length within the file): the gltf
@@ -279,9 +283,26 @@ fn glb_body(bytes: &[u8]) -> Result<&[u8]> {
     Ok(&bytes[..length])
 }
 
-/// What `gltf`'s validation leaves to accessors that would panic on it.
+/// What `gltf`'s validation would panic on, or leaves to accessors that
+/// would panic on it.
 fn check_json(root: &gltf::json::Root) -> Result<()> {
     use gltf::json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "an attribute".into(),
+                    };
+                    bail!(
+                        "mesh {m} primitive {p}: {name} names accessor {}, which does not exist",
+                        index.value()
+                    );
+                }
+            }
+        }
+    }
     for (i, c) in root.cameras.iter().enumerate() {
         let ok = match c.type_ {
             Checked::Valid(gltf::json::camera::Type::Perspective) => c.perspective.is_some(),
