@@ -25,6 +25,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene headless and write EXR, PNG and per-pass GPU timings.
+    #[command(allow_negative_numbers = true)]
     Render(Box<RenderArgs>),
     /// List the Vulkan devices (the index is what --device takes).
     Devices,
@@ -44,6 +45,10 @@ struct RenderArgs {
     /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
     #[arg(long)]
     scene: Option<PathBuf>,
+    /// Let the scene's buffer and image URIs name files outside its folder
+    /// (absolute paths, '..', file: URIs, symbolic links out of it).
+    #[arg(long)]
+    allow_outside_uris: bool,
     /// How indirect light is computed.
     #[arg(long, value_enum, default_value_t = D.method)]
     method: Method,
@@ -133,7 +138,7 @@ struct RenderArgs {
     #[arg(long, default_value_t = D.reference_chunk)]
     reference_chunk: u64,
     /// Indirect samples per pixel for --method pathtrace.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
     spp: u32,
     /// Random seed for --method pathtrace.
     #[arg(long, default_value_t = 1)]
@@ -438,8 +443,15 @@ fn sequence(
 
 fn render(args: RenderArgs) -> Result<()> {
     args.check_motion()?;
+    output::check_render_outputs(&args.out, &args.png, args.timings.as_deref())?;
     let scene = match &args.scene {
-        Some(path) => scene::gltf_load::load(path)?,
+        Some(path) => scene::gltf_load::load_with(
+            path,
+            &scene::gltf_load::LoadOptions {
+                allow_outside_uris: args.allow_outside_uris,
+                ..Default::default()
+            },
+        )?,
         None => scene::cornell::cornell_box(),
     };
     for w in &scene.warnings {

@@ -2,11 +2,14 @@
 //! light and one perspective camera. Loaded from glTF (`gltf_load`), built in
 //! (`cornell`), or assembled by code (tests) with the helpers below.
 
+mod accessor;
 pub mod animation;
 pub mod cornell;
 pub mod export;
 pub mod gltf_load;
+pub mod limits;
 pub mod motion;
+mod uri;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -359,9 +362,21 @@ pub fn cuboid(center: Vec3, size: Vec3, yaw: f32) -> (Vec<GpuVertex>, Vec<u32>) 
 
 /// Face normals accumulated per vertex, for primitives without NORMAL.
 pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
+    // Positions scaled to about unit size first: at 1e18 m the cross product
+    // (1e36) would overflow when normalised. One scale for the whole mesh
+    // keeps the area weights' ratios.
+    let extent = vertices
+        .iter()
+        .flat_map(|v| v.position)
+        .fold(0f32, |m, c| m.max(c.abs()));
+    let scale = if extent > 0.0 && extent.is_finite() {
+        1.0 / extent
+    } else {
+        1.0
+    };
     let mut acc = vec![Vec3::ZERO; vertices.len()];
     for t in indices.chunks_exact(3) {
-        let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
+        let p = |k: usize| Vec3::from(vertices[t[k] as usize].position) * scale;
         // Area-weighted: the cross product's length is twice the area.
         let n = (p(1) - p(0)).cross(p(2) - p(0));
         for &k in t {
