@@ -159,7 +159,7 @@ fn corpus() -> Vec<(Value, Option<Vec<u8>>)> {
     tri["buffers"][0] = json!({"byteLength": bin.len()});
     out.push((tri.clone(), Some(bin.clone())));
     let view = |tri: &mut Value, bin: &mut Vec<u8>, bytes: &[u8]| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let views = tri["bufferViews"].as_array_mut().unwrap();
@@ -815,7 +815,7 @@ fn loader_never_panics_hangs_or_allocates_without_bound() {
         }
     }
     let mut common: Vec<_> = messages.into_iter().collect();
-    common.sort_by(|a, b| b.1.cmp(&a.1));
+    common.sort_by_key(|c| std::cmp::Reverse(c.1));
     for (m, n) in common.iter().take(15) {
         println!("{n:6}  {m}");
     }

@@ -29,7 +29,7 @@ fn err(r: anyhow::Result<Scene>) -> String {
 
 /// Appends `bytes` to the buffer (4-aligned) and a view of them; returns the view.
 fn push_view(doc: &mut Value, bin: &mut Vec<u8>, bytes: &[u8]) -> usize {
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let views = doc["bufferViews"].as_array_mut().unwrap();

@@ -520,7 +520,8 @@ fn unwritable_and_directory_outputs_are_refused_before_rendering() {
         ],
     );
     assert!(e.contains("--timings file/t.json"), "{e}");
-    for e in [&e] {
+    {
+        let e = &e;
         assert!(
             !e.contains("rendering"),
             "checked only after rendering:\n{e}"

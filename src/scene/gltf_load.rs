@@ -190,7 +190,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         .bounds()
         .ok_or_else(|| anyhow!("the scene has no vertices to render"))?;
     let reach = lo.abs().max(hi.abs()).max_element();
-    if !(reach <= limits.coordinate) {
+    if reach.is_nan() || reach > limits.coordinate {
         bail!(
             "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m (scale the scene down)",
             limits.coordinate
@@ -963,7 +963,7 @@ fn default_camera() -> Camera {
 }
 
 /// A spot light just below the top of the bounds, pointing down, bright enough
-/// that a white floor at the bottom reflects radiance of about 1 (ALGORITHM.md 2).
+/// that a white floor at the bottom reflects radiance of about 1 (docs/algorithm.md section 2).
 /// Finite for any finite bounds: sizes are taken in f64 and the intensity is
 /// clamped to the largest f32 (only reached far beyond `Limits::coordinate`).
 pub fn fitted_light(lo: Vec3, hi: Vec3) -> SpotLight {

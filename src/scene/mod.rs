@@ -82,7 +82,7 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
-/// A `KHR_lights_punctual` spot light (ALGORITHM.md section 2).
+/// A `KHR_lights_punctual` spot light (docs/algorithm.md section 2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpotLight {
     pub position: Vec3,

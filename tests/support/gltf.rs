@@ -37,7 +37,7 @@ pub fn data_uri(bytes: &[u8]) -> String {
 /// A GLB: 12-byte header, JSON chunk (space-padded), optional BIN chunk.
 pub fn glb(doc: &Value, bin: Option<&[u8]>) -> Vec<u8> {
     let mut json = serde_json::to_vec(doc).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let mut out = Vec::new();
