@@ -344,8 +344,7 @@ pub fn run() -> Result<()> {
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {
             let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;
-            std::fs::write(&path, json)
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            output::write_text(&path, &json)?;
             println!("wrote {}", path.display());
             Ok(())
         }
@@ -424,7 +423,7 @@ fn sequence(
     eprintln!();
     let path = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": reports }))?;
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    output::write_text(&path, &text)?;
     println!(
         "wrote {} frames ({}/frame_0000.exr ...) and {}",
         args.frames,

@@ -120,7 +120,7 @@ pub fn write_json(path: &Path, report: &TimingReport) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let text = serde_json::to_string_pretty(report)?;
-    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+    crate::output::write_text(path, &text)
 }
 
 /// Patches per level against the area of all layers (what an unstenciled
