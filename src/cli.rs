@@ -187,6 +187,27 @@ impl RenderArgs {
         state
     }
 
+    /// The timing report of `stats` for this run.
+    fn report(
+        &self,
+        gpu: &Gpu,
+        scene: &scene::Scene,
+        stats: &crate::renderer::FrameStats,
+    ) -> report::TimingReport {
+        report::build(
+            &report::RunInfo {
+                device: &gpu.info.name,
+                driver: &gpu.info.driver,
+                scene: &scene.name,
+                width: self.width,
+                height: self.height,
+                rsm: self.rsm,
+                method: self.method.name(),
+            },
+            stats,
+        )
+    }
+
     fn check_motion(&self) -> Result<()> {
         if !self.time.is_finite() {
             bail!(
@@ -398,18 +419,7 @@ fn sequence(
         let png = dir.join(format!("frame_{k:04}.png"));
         output::write_exr(&exr, &result)?;
         output::write_png(&png, result.width, result.height, &result.display)?;
-        let mut r = report::build(
-            &report::RunInfo {
-                device: &gpu.info.name,
-                driver: &gpu.info.driver,
-                scene: &scene.name,
-                width: args.width,
-                height: args.height,
-                rsm: args.rsm,
-                method: args.method.name(),
-            },
-            &stats,
-        );
+        let mut r = args.report(gpu, scene, &stats);
         r.time = Some(t);
         reports.push(r);
         let p = crate::renderer::FrameProgress {
@@ -566,18 +576,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let total_area = renderer.multires().map(|m| m.total_area());
     drop(renderer);
 
-    let r = report::build(
-        &report::RunInfo {
-            device: &gpu.info.name,
-            driver: &gpu.info.driver,
-            scene: &scene.name,
-            width: args.width,
-            height: args.height,
-            rsm: args.rsm,
-            method: args.method.name(),
-        },
-        &stats,
-    );
+    let r = args.report(&gpu, &scene, &stats);
     let mut r = r;
     r.light_patches = light_stats.clone();
     print!("{}", report::table(&r));

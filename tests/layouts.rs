@@ -12,14 +12,7 @@ const OP_MEMBER_NAME: u32 = 6;
 const OP_MEMBER_DECORATE: u32 = 72;
 const DECORATION_OFFSET: u32 = 35;
 
-fn string_at(words: &[u32]) -> String {
-    let bytes: Vec<u8> = words
-        .iter()
-        .flat_map(|w| w.to_le_bytes())
-        .take_while(|&b| b != 0)
-        .collect();
-    String::from_utf8(bytes).unwrap()
-}
+use isr::vk::reflect::string_at;
 
 /// For every struct type named `name` in `shader`: member name -> byte offset.
 fn struct_layouts(shader: &str, name: &str) -> Vec<HashMap<String, u32>> {

@@ -45,7 +45,8 @@ const STORAGE_UNIFORM_CONSTANT: u32 = 0;
 const STORAGE_UNIFORM: u32 = 2;
 const STORAGE_STORAGE_BUFFER: u32 = 12;
 
-fn string_at(words: &[u32]) -> String {
+/// The nul-terminated string that starts at `words` (SPIR-V literal strings).
+pub fn string_at(words: &[u32]) -> String {
     let bytes: Vec<u8> = words
         .iter()
         .flat_map(|w| w.to_le_bytes())
