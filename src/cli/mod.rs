@@ -11,6 +11,9 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
+mod runs;
+use runs::*;
+
 #[derive(Parser)]
 #[command(
     name = "isr",
@@ -245,84 +248,6 @@ enum DebugView {
     VplCount,
 }
 
-/// `--method pathtrace`: the CPU reference, with a progress bar.
-fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
-    if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
-        bail!(
-            "resolution {}x{}: width and height must be within 1..=16384",
-            args.width,
-            args.height
-        );
-    }
-    if args.spp == 0 {
-        bail!("--spp must be at least 1");
-    }
-    let threads = rayon::current_num_threads();
-    eprintln!(
-        "path tracing {} ({} triangles) at {}x{}, {} spp, on {threads} CPU threads",
-        scene.name,
-        scene.triangle_count(),
-        args.width,
-        args.height,
-        args.spp
-    );
-    let started = std::time::Instant::now();
-    let result = crate::pathtrace::render(
-        scene,
-        &crate::pathtrace::PathTraceSettings {
-            width: args.width,
-            height: args.height,
-            spp: args.spp,
-            seed: args.seed,
-            exposure: args.exposure,
-        },
-        |done, rows| {
-            let fraction = done as f64 / rows as f64;
-            let elapsed = started.elapsed().as_secs_f64();
-            let left = if fraction > 0.0 {
-                elapsed / fraction - elapsed
-            } else {
-                0.0
-            };
-            let filled = (fraction * 30.0).round() as usize;
-            eprint!(
-                "\r[{}{}] {:>3.0}% rows {done}/{rows}, {left:.0} s left ",
-                "#".repeat(filled),
-                "-".repeat(30 - filled),
-                fraction * 100.0
-            );
-        },
-    );
-    eprintln!();
-    let ms = started.elapsed().as_secs_f64() * 1e3;
-    println!("pathtrace: {ms:.1} ms on {threads} CPU threads");
-    if let Some(path) = &args.timings {
-        let r = report::TimingReport {
-            device: format!("CPU ({threads} threads)"),
-            driver: "isr::pathtrace".into(),
-            scene: scene.name.clone(),
-            width: args.width,
-            height: args.height,
-            rsm: 0,
-            method: Method::Pathtrace.name().into(),
-            frames: 1,
-            passes: vec![],
-            total_gpu_ms_median: None,
-            indirect_gpu_ms_median: None,
-            wall_ms_median: ms,
-            patches_per_level: None,
-            light_patches: None,
-            time: None,
-        };
-        report::write_json(path, &r)?;
-        println!("wrote {}", path.display());
-    }
-    output::write_exr(&args.out, &result)?;
-    output::write_png(&args.png, result.width, result.height, &result.display)?;
-    println!("wrote {} and {}", args.out.display(), args.png.display());
-    Ok(())
-}
-
 /// A one-line progress bar (redrawn in place): frames, and the submissions of
 /// the current frame when there are several (the reference's chunks), with
 /// the time left estimated from the time so far.
@@ -391,60 +316,6 @@ fn devices() -> Result<()> {
             d.unusable
                 .map(|w| format!(" (unusable: {w})"))
                 .unwrap_or_default()
-        );
-    }
-    Ok(())
-}
-
-/// `--sequence DIR`: frame k at time `--time + k / --fps`, each written as
-/// EXR and PNG, and every frame's per-pass times in `DIR/timings.json`.
-fn sequence(
-    args: &RenderArgs,
-    scene: &scene::Scene,
-    gpu: &Gpu,
-    renderer: &mut Renderer,
-    dir: &std::path::Path,
-) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let started = std::time::Instant::now();
-    let mut reports = Vec::new();
-    for k in 0..args.frames {
-        let t = args.time + k as f32 / args.fps;
-        renderer.update(&args.state_at(scene, t))?;
-        // Each frame is its own run of one frame: its images are read back
-        // before the next one changes the scene.
-        let stats = renderer.render_frames(1, |_| {})?;
-        let result = renderer.readback()?;
-        let exr = dir.join(format!("frame_{k:04}.exr"));
-        let png = dir.join(format!("frame_{k:04}.png"));
-        output::write_exr(&exr, &result)?;
-        output::write_png(&png, result.width, result.height, &result.display)?;
-        let mut r = args.report(gpu, scene, &stats);
-        r.time = Some(t);
-        reports.push(r);
-        let p = crate::renderer::FrameProgress {
-            frame: k + 1,
-            frames: args.frames,
-            submission: 1,
-            submissions: 1,
-        };
-        eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
-    }
-    eprintln!();
-    let path = dir.join("timings.json");
-    let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": reports }))?;
-    output::write_text(&path, &text)?;
-    println!(
-        "wrote {} frames ({}/frame_0000.exr ...) and {}",
-        args.frames,
-        dir.display(),
-        path.display()
-    );
-    let messages = gpu.take_validation_messages();
-    if !messages.is_empty() {
-        bail!(
-            "the validation layer reported {} message(s) (printed above)",
-            messages.len()
         );
     }
     Ok(())
