@@ -282,6 +282,30 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(
     })
 }
 
+/// Tonemapped RGBA8 frames as a looping animated GIF at `fps` (each frame
+/// quantised to its own 256-colour palette by the encoder).
+pub fn write_gif(
+    path: &Path,
+    width: u32,
+    height: u32,
+    frames: Vec<Vec<u8>>,
+    fps: f32,
+) -> Result<()> {
+    use image::codecs::gif::{GifEncoder, Repeat};
+    // GIF delays are whole hundredths of a second.
+    let delay = image::Delay::from_numer_denom_ms((1000.0 / fps).round().max(10.0) as u32, 1);
+    write_atomic(path, |out| {
+        let mut encoder = GifEncoder::new_with_speed(out, 10);
+        encoder.set_repeat(Repeat::Infinite)?;
+        for rgba in frames {
+            let image = image::RgbaImage::from_raw(width, height, rgba)
+                .ok_or_else(|| anyhow!("a frame does not have {width}x{height} pixels"))?;
+            encoder.encode_frame(image::Frame::from_parts(image, 0, 0, delay))?;
+        }
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -167,6 +167,10 @@ struct RenderArgs {
     /// Frames per second of a --sequence.
     #[arg(long, default_value_t = 30.0)]
     fps: f32,
+    /// With --sequence, also write the frames as a looping animated GIF,
+    /// DIR/sequence.gif, played at --fps.
+    #[arg(long, requires = "sequence")]
+    gif: bool,
     /// Circle the light about the scene's vertical axis through its initial
     /// position, once per PERIOD seconds, still aimed at the same point.
     #[arg(long, value_name = "PERIOD")]

@@ -81,6 +81,9 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
     Ok(())
 }
 
+/// The most memory `--gif` may hold in frames (RGBA8).
+const MAX_GIF_BYTES: u64 = 2 << 30;
+
 /// `--sequence DIR`: frame k at time `--time + k / --fps`, each written as
 /// EXR and PNG, and every frame's per-pass times in `DIR/timings.json`.
 pub(super) fn sequence(
@@ -93,6 +96,22 @@ pub(super) fn sequence(
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let started = std::time::Instant::now();
     let mut reports = Vec::new();
+    let mut gif_frames = Vec::new();
+    if args.gif {
+        // The frames are kept for the GIF: refuse a length that cannot fit.
+        let bytes = args.frames as u64 * args.width as u64 * args.height as u64 * 4;
+        if bytes > MAX_GIF_BYTES {
+            bail!(
+                "--gif: {} frames of {}x{} need {} MiB in memory (the limit is {} MiB); \
+                 render fewer or smaller frames",
+                args.frames,
+                args.width,
+                args.height,
+                bytes >> 20,
+                MAX_GIF_BYTES >> 20
+            );
+        }
+    }
     for k in 0..args.frames {
         let t = args.time + k as f32 / args.fps;
         renderer.update(&args.state_at(scene, t))?;
@@ -104,6 +123,9 @@ pub(super) fn sequence(
         let png = dir.join(format!("frame_{k:04}.png"));
         output::write_exr(&exr, &result)?;
         output::write_png(&png, result.width, result.height, &result.display)?;
+        if args.gif {
+            gif_frames.push(result.display);
+        }
         let mut r = args.report(gpu, scene, &stats);
         r.time = Some(t);
         reports.push(r);
@@ -125,6 +147,11 @@ pub(super) fn sequence(
         dir.display(),
         path.display()
     );
+    if args.gif {
+        let gif = dir.join("sequence.gif");
+        output::write_gif(&gif, args.width, args.height, gif_frames, args.fps)?;
+        println!("wrote {}", gif.display());
+    }
     let messages = gpu.take_validation_messages();
     if !messages.is_empty() {
         bail!(
