@@ -21,13 +21,15 @@ pub enum OutputKind {
     Png,
     /// `--timings`: the JSON report.
     Json,
+    /// `--debug-view`: a PNG named after `--png`.
+    DebugPng,
 }
 
 impl OutputKind {
     pub fn extension(self) -> &'static str {
         match self {
             OutputKind::Exr => "exr",
-            OutputKind::Png => "png",
+            OutputKind::Png | OutputKind::DebugPng => "png",
             OutputKind::Json => "json",
         }
     }
@@ -37,6 +39,7 @@ impl OutputKind {
             OutputKind::Exr => "--out",
             OutputKind::Png => "--png",
             OutputKind::Json => "--timings",
+            OutputKind::DebugPng => "--debug-view",
         }
     }
 }
@@ -64,7 +67,7 @@ pub fn check_outputs(outputs: &[(OutputKind, &Path)]) -> Result<()> {
                 kind.extension(),
                 match kind {
                     OutputKind::Exr => "an OpenEXR image",
-                    OutputKind::Png => "a PNG image",
+                    OutputKind::Png | OutputKind::DebugPng => "a PNG image",
                     OutputKind::Json => "JSON",
                 }
             );
@@ -118,6 +121,24 @@ pub fn check_outputs(outputs: &[(OutputKind, &Path)]) -> Result<()> {
         }
         seen.push((key, kind, path));
     }
+    Ok(())
+}
+
+/// Checks, before any work, that `--sequence DIR` is a folder (created if
+/// missing) that can be written.
+pub fn check_sequence_dir(dir: &Path) -> Result<()> {
+    if std::fs::metadata(dir).is_ok_and(|m| !m.is_dir()) {
+        bail!(
+            "--sequence {}: it exists and is not a folder",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("--sequence {}: cannot create the folder", dir.display()))?;
+    let probe = temp_file(&dir.join("frame_0000.exr"))
+        .with_context(|| format!("--sequence {}: the folder is not writable", dir.display()))?;
+    drop(probe.1);
+    let _ = std::fs::remove_file(&probe.0);
     Ok(())
 }
 

@@ -560,3 +560,142 @@ fn spp_is_bounded() {
     assert!(e.contains("--spp") && e.contains("1..=65536"), "{e}");
     assert!(took < Duration::from_secs(5), "took {took:?}");
 }
+
+#[test]
+fn debug_views_and_sequence_folders_are_checked_before_rendering() {
+    let dir = temp_dir("debug-out");
+    let e = fails(&dir, &["--method", "rsm-gather", "--debug-view", "levels"]);
+    assert!(
+        e.contains("--debug-view levels") && e.contains("rsm-gather"),
+        "{e}"
+    );
+    std::fs::create_dir_all(dir.join("r-levels.png")).unwrap();
+    let e = fails(
+        &dir,
+        &["--out", "r.exr", "--png", "r.png", "--debug-view", "levels"],
+    );
+    assert!(
+        e.contains("--debug-view r-levels.png is a directory"),
+        "{e}"
+    );
+    std::fs::write(dir.join("seq"), b"a file").unwrap();
+    let e = fails(&dir, &["--sequence", "seq"]);
+    assert!(
+        e.contains("--sequence seq") && e.contains("not a folder"),
+        "{e}"
+    );
+    assert!(
+        !e.contains("rendering"),
+        "checked only after rendering:\n{e}"
+    );
+}
+
+#[test]
+fn a_one_pixel_image_names_the_resolution_not_levels() {
+    let dir = temp_dir("one-pixel");
+    let one_pixel = |method: &str| {
+        bin()
+            .args([
+                "render", "--width", "1", "--height", "1", "--rsm", "32", "--vpls", "16",
+            ])
+            .args([
+                "--frames", "1", "--out", "o.exr", "--png", "o.png", "--method", method,
+            ])
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let out = one_pixel("hisr");
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{e}");
+    assert!(
+        e.contains("resolution 1x1") && e.contains("at least 2x2") && !e.contains("--levels"),
+        "{e}"
+    );
+    // Methods without the multiresolution buffer render one pixel.
+    let out = one_pixel("rsm-gather");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Runs `isr render` with `ISR_INJECT_FAULT` (the test hook for what real GPUs
+/// do and lavapipe does not): the given submission fails.
+fn with_fault(dir: &Path, fault: &str, args: &[&str]) -> String {
+    let out = bin()
+        .arg("render")
+        .args([
+            "--width", "32", "--height", "32", "--rsm", "32", "--frames", "40",
+        ])
+        .args(args)
+        .env("ISR_INJECT_FAULT", fault)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    e
+}
+
+#[test]
+fn device_loss_mid_run_leaves_old_outputs_and_says_so() {
+    let dir = temp_dir("device-lost");
+    for f in ["r.exr", "r.png", "t.json"] {
+        std::fs::write(dir.join(f), b"old").unwrap();
+    }
+    // Submission 20 is well past the scene upload: frames are in flight.
+    let e = with_fault(
+        &dir,
+        "device-lost:20",
+        &["--out", "r.exr", "--png", "r.png", "--timings", "t.json"],
+    );
+    assert!(
+        e.contains("frame 2/40"),
+        "the fault came before the frames:\n{e}"
+    );
+    assert!(
+        e.contains("error: rendering failed; no output was written (existing files are untouched)")
+            && e.contains("the GPU device was lost"),
+        "{e}"
+    );
+    // The error starts its own line, not the progress bar's.
+    assert!(e.lines().any(|l| l.starts_with("error:")), "{e}");
+    for f in ["r.exr", "r.png", "t.json"] {
+        assert_eq!(std::fs::read(dir.join(f)).unwrap(), b"old", "{f}");
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 3, "temporary files left: {left:?}");
+}
+
+#[test]
+fn out_of_memory_mid_sequence_names_the_frames_kept() {
+    let dir = temp_dir("oom-sequence");
+    let e = with_fault(&dir, "out-of-memory:20", &["--sequence", "seq"]);
+    assert!(e.contains("the GPU ran out of memory"), "{e}");
+    let kept: Vec<String> = std::fs::read_dir(dir.join("seq"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    assert!(!kept.is_empty(), "{e}");
+    let last = kept.len() - 1;
+    assert!(
+        e.contains(&format!("rendering frame {} ", kept.len()))
+            && e.contains(&format!("frames 0000 to {last:04} in seq are complete"))
+            && e.contains("timings.json was not written"),
+        "{e}\nkept {kept:?}"
+    );
+    assert!(!dir.join("seq/timings.json").exists());
+    for name in &kept {
+        image::open(dir.join("seq").join(name)).unwrap_or_else(|err| panic!("{name}: {err}"));
+    }
+    // A malformed hook is an error too, not ignored.
+    let e = with_fault(&dir, "melt:1", &[]);
+    assert!(e.contains("ISR_INJECT_FAULT=melt:1"), "{e}");
+}

@@ -1,6 +1,7 @@
 //! The `isr` command line: argument parsing and the `render`, `devices` and
 //! `export-builtin` commands. `main.rs` only calls [`run`].
 
+use crate::output::OutputKind;
 use crate::renderer::Renderer;
 use crate::settings::{
     LightTreeSettings, Method, MultiresSettings, RenderSettings, Upsample, VplSampling,
@@ -215,6 +216,21 @@ impl RenderArgs {
         )
     }
 
+    /// Where `--debug-view` writes `view`: next to --png, named after it.
+    fn debug_view_path(&self, view: DebugView) -> PathBuf {
+        let suffix = match view {
+            DebugView::Levels => "levels",
+            DebugView::Indirect => "indirect",
+            DebugView::VplCount => "vpl-count",
+        };
+        let stem = self
+            .png
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        self.png.with_file_name(format!("{stem}-{suffix}.png"))
+    }
+
     fn check_motion(&self) -> Result<()> {
         if !self.time.is_finite() {
             bail!(
@@ -245,7 +261,7 @@ enum OnOff {
     Off,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum DebugView {
     Levels,
     Indirect,
@@ -257,11 +273,12 @@ enum DebugView {
 /// the time left estimated from the time so far.
 fn progress_line(p: &crate::renderer::FrameProgress, elapsed: f64) -> String {
     let total = (p.frames * p.submissions) as f64;
-    let done = ((p.frame.min(p.frames - 1) * p.submissions) + p.submission) as f64;
-    let done = if p.frame == p.frames && p.submission == p.submissions {
+    // A frame's completion is reported with submission 0, the parts of a
+    // multi-submission frame with 1..submissions.
+    let done = if p.frame >= p.frames {
         total
     } else {
-        done
+        ((p.frame * p.submissions) + p.submission) as f64
     };
     let fraction = (done / total).clamp(0.0, 1.0);
     let width = 30;
@@ -327,7 +344,37 @@ fn devices() -> Result<()> {
 
 fn render(args: RenderArgs) -> Result<()> {
     args.check_motion()?;
-    output::check_render_outputs(&args.out, &args.png, args.timings.as_deref())?;
+    let needs_multires = args
+        .debug_view
+        .iter()
+        .any(|v| matches!(v, DebugView::Levels | DebugView::VplCount));
+    if needs_multires && !args.method.uses_multires() {
+        bail!(
+            "--debug-view levels and vpl-count need a method with the multiresolution buffer \
+             (multires-gather, multires-splat, isr, hisr); --method {} has none",
+            args.method.name()
+        );
+    }
+    let debug_pngs: Vec<PathBuf> = args
+        .debug_view
+        .iter()
+        .map(|&v| args.debug_view_path(v))
+        .collect();
+    let mut outputs = vec![
+        (OutputKind::Exr, args.out.as_path()),
+        (OutputKind::Png, &args.png),
+    ];
+    outputs.extend(args.timings.as_deref().map(|t| (OutputKind::Json, t)));
+    outputs.extend(
+        debug_pngs
+            .iter()
+            .map(|p| (OutputKind::DebugPng, p.as_path())),
+    );
+    if args.sequence.is_none() {
+        output::check_outputs(&outputs)?;
+    } else if let Some(dir) = &args.sequence {
+        output::check_sequence_dir(dir)?;
+    }
     let scene = match &args.scene {
         Some(path) => scene::gltf_load::load_with(
             path,
@@ -407,14 +454,23 @@ fn render(args: RenderArgs) -> Result<()> {
     renderer.update(&args.state_at(&scene, args.time))?;
     let frames = args.frames;
     let started = std::time::Instant::now();
-    let stats = renderer.render_frames(frames, |p| {
-        if frames > 1 || p.submissions > 1 {
-            eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
-            if p.frame == p.frames && p.submission == p.submissions {
+    let mut line_open = false;
+    let stats = renderer
+        .render_frames(frames, |p| {
+            if frames > 1 || p.submissions > 1 {
+                eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
+                line_open = p.frame < p.frames;
+                if !line_open {
+                    eprintln!();
+                }
+            }
+        })
+        .map_err(|e| {
+            if line_open {
                 eprintln!();
             }
-        }
-    })?;
+            e.context("rendering failed; no output was written (existing files are untouched)")
+        })?;
     let result = renderer.readback()?;
     // For --stats, the debug views and the timings JSON's light-patch numbers.
     let multires = renderer.readback_multires()?;
@@ -426,27 +482,23 @@ fn render(args: RenderArgs) -> Result<()> {
         None => None,
     };
     let mut extra_views = Vec::new();
-    for view in &args.debug_view {
-        let (suffix, what, rgba) = match (view, &multires) {
+    for &view in &args.debug_view {
+        let (what, rgba) = match (view, &multires) {
             (DebugView::Indirect, _) => continue,
-            (_, None) => bail!(
-                "--debug-view levels and vpl-count need a method with the multiresolution buffer"
-            ),
+            (_, None) => unreachable!("checked before rendering"),
             (DebugView::Levels, Some(m)) => (
-                "levels",
                 format!("patch level per pixel: {}", crate::debug_view::LEVEL_LEGEND),
                 crate::debug_view::levels_png(m),
             ),
             (DebugView::VplCount, Some(m)) => {
                 let (rgba, min, max) = crate::debug_view::vpl_count_png(m);
                 (
-                    "vpl-count",
                     format!("light patches evaluated per pixel, black {min} to white {max}"),
                     rgba,
                 )
             }
         };
-        extra_views.push((suffix, what, rgba));
+        extra_views.push((args.debug_view_path(view), what, rgba));
     }
     let total_area = renderer.multires().map(|m| m.total_area());
     drop(renderer);
@@ -474,21 +526,12 @@ fn render(args: RenderArgs) -> Result<()> {
     output::write_exr(&args.out, &result)?;
     output::write_png(&args.png, result.width, result.height, &result.display)?;
     println!("wrote {} and {}", args.out.display(), args.png.display());
-    let sibling = |suffix: &str| {
-        let stem = args
-            .png
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        args.png.with_file_name(format!("{stem}-{suffix}.png"))
-    };
-    for (suffix, what, rgba) in extra_views {
-        let path = sibling(suffix);
+    for (path, what, rgba) in extra_views {
         output::write_png(&path, result.width, result.height, &rgba)?;
         println!("wrote {} ({what})", path.display());
     }
     if args.debug_view.contains(&DebugView::Indirect) {
-        let path = sibling("indirect");
+        let path = args.debug_view_path(DebugView::Indirect);
         let rgba = crate::debug_view::indirect_png(&result, args.exposure);
         output::write_png(&path, result.width, result.height, &rgba)?;
         println!(

@@ -117,7 +117,23 @@ pub(super) fn sequence(
         renderer.update(&args.state_at(scene, t))?;
         // Each frame is its own run of one frame: its images are read back
         // before the next one changes the scene.
-        let stats = renderer.render_frames(1, |_| {})?;
+        let stats = renderer.render_frames(1, |_| {}).map_err(|e| {
+            if k > 0 {
+                eprintln!();
+            }
+            e.context(format!(
+                "rendering frame {k} (t = {t} s) failed; {}timings.json was not written",
+                if k > 0 {
+                    format!(
+                        "frames 0000 to {:04} in {} are complete, ",
+                        k - 1,
+                        dir.display()
+                    )
+                } else {
+                    String::new()
+                }
+            ))
+        })?;
         let result = renderer.readback()?;
         let exr = dir.join(format!("frame_{k:04}.exr"));
         let png = dir.join(format!("frame_{k:04}.png"));

@@ -110,6 +110,16 @@ pub fn check_ranges(s: &RenderSettings) -> Result<()> {
     if s.method == Method::MultiresSplat && !s.multires.stencil {
         bail!("--stencil off measures the stenciled gathers; multires-splat always splats through the stencil");
     }
+    if s.method.uses_multires() && (s.width < 2 || s.height < 2) {
+        bail!(
+            "resolution {}x{}: method {} needs at least 2x2 pixels (its multiresolution buffer's \
+             coarsest level halves the image at least once); use a larger --width/--height, or a \
+             method without that buffer (rsm-gather, rsm-splat, reference)",
+            s.width,
+            s.height,
+            s.method.name()
+        );
+    }
     if !s.method.uses_regular_vpls() {
         return Ok(());
     }
@@ -128,7 +138,12 @@ pub fn check_ranges(s: &RenderSettings) -> Result<()> {
         );
     }
     let levels = s.levels();
-    if levels == 0 || levels >= MAX_LEVELS || s.width >> levels == 0 || s.height >> levels == 0 {
+    if s.method.uses_multires()
+        && (levels == 0
+            || levels >= MAX_LEVELS
+            || s.width >> levels == 0
+            || s.height >> levels == 0)
+    {
         let what = if s.multires.levels.is_some() {
             format!("--levels {levels}")
         } else {

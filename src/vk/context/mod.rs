@@ -9,6 +9,7 @@ use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex};
 
 mod devices;
+mod fault;
 pub use devices::list_devices;
 use devices::*;
 
@@ -147,6 +148,8 @@ pub struct Gpu {
     /// Object names and command labels, present when VK_EXT_debug_utils is.
     pub debug_device: Option<ash::ext::debug_utils::Device>,
     validation_log: Option<Arc<ValidationLog>>,
+    /// The test hook of `fault.rs`; `None` in normal runs.
+    injected_fault: Option<fault::InjectedFault>,
 }
 
 unsafe extern "system" fn debug_callback(
@@ -230,6 +233,7 @@ fn create_instance(entry: &ash::Entry, validate: bool) -> Result<ash::Instance> 
 
 impl Gpu {
     pub fn new(options: &GpuOptions) -> Result<Self> {
+        let injected_fault = fault::InjectedFault::from_env()?;
         let entry = load_entry()?;
         let validate = match options.validation {
             Validation::Off => false,
@@ -420,6 +424,7 @@ impl Gpu {
             submit_fence,
             debug_device,
             validation_log,
+            injected_fault,
         })
     }
 
@@ -481,6 +486,9 @@ impl Gpu {
     pub fn submit(&self, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<()> {
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        if let Some(e) = self.injected_fault.as_ref().and_then(|f| f.on_submit()) {
+            return Err(submit_error(e));
+        }
         unsafe { self.device.queue_submit2(self.queue, &submit, fence) }.map_err(submit_error)
     }
 
@@ -527,12 +535,12 @@ impl Gpu {
 fn submit_error(e: vk::Result) -> anyhow::Error {
     match e {
         vk::Result::ERROR_DEVICE_LOST => anyhow!(
-            "the GPU device was lost (a driver timeout or crash); no output was written. \
+            "the GPU device was lost (a driver timeout or crash). \
              Try a smaller --width/--height or --rsm, or a lighter method"
         ),
-        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => anyhow!(
-            "the GPU ran out of memory ({e}); no output was written. Try a smaller --width/--height or --rsm"
-        ),
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+            anyhow!("the GPU ran out of memory ({e}). Try a smaller --width/--height or --rsm")
+        }
         e => anyhow!("queue submission failed: {e}"),
     }
 }
