@@ -21,5 +21,6 @@ pub mod renderer;
 pub mod report;
 pub mod scene;
 pub mod settings;
+pub mod soak;
 pub mod view;
 pub mod vk;
