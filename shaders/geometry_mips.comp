@@ -4,10 +4,11 @@
 // Per texel: mean position and view depth, mean normal and coverage, the
 // depth and normal-component ranges, and the flags smooth / split.
 //
-// Discontinuities on texel borders: level 0's ranges are taken over the 3x3
-// pixel neighbourhood, so every coarser texel's range covers its footprint
-// plus a one-pixel ring and an edge lying exactly on a border is seen by the
-// texels on both sides.
+// Discontinuities on texel borders: every texel's range covers its footprint
+// plus a one-pixel ring, so an edge lying exactly on a border is seen by the
+// texels on both sides. Level 1 takes its ranges straight from the G-buffer's
+// 4x4 pixels (its 2x2 children and their ring); level 0 needs none (it is
+// always smooth), which saves a 3x3 neighbourhood per pixel and two images.
 //
 // 2:1 balance: a texel splits if it is not smooth, or if any texel of level
 // l - 1 in the 4x4 block around its children (its children and the ring of
@@ -18,7 +19,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
-// Level l - 1 (unused at level 0).
+// Level l - 1 (unused at level 0; the ranges are unused at level 1 too, and
+// the range images hold levels 1..L).
 layout(set = 1, binding = 2, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
 layout(set = 1, binding = 3, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
 layout(set = 1, binding = 4, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
@@ -46,18 +48,25 @@ void level_zero(ivec2 p) {
     if (pos.w <= 0.0) {
         imageStore(dst_mean, p, vec4(0.0));
         imageStore(dst_normal, p, vec4(0.0));
-        imageStore(dst_min, p, vec4(BIG));
-        imageStore(dst_max, p, vec4(-BIG));
         imageStore(dst_flags, p, uvec4(0u));
         return;
     }
     // Renormalised: the G-buffer stores normals as 16-bit floats.
     vec3 n = normalize(texelFetch(gbuffer_normal, p, 0).xyz);
-    vec4 lo = vec4(BIG), hi = vec4(-BIG);
+    imageStore(dst_mean, p, pos);
+    imageStore(dst_normal, p, vec4(n, 1.0));
+    imageStore(dst_flags, p, uvec4(GEO_HAS_GEOMETRY | GEO_SMOOTH));  // level 0 is always smooth
+}
+
+// Depth and normal ranges of a level-1 texel: the G-buffer's pixels with
+// geometry among its 2x2 children and their one-pixel ring.
+void level_one_ranges(ivec2 p, out vec4 lo, out vec4 hi) {
+    lo = vec4(BIG);
+    hi = vec4(-BIG);
     ivec2 size = ivec2(run.size.xy);
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 q = p + ivec2(dx, dy);
+    for (int dy = -1; dy <= 2; ++dy) {
+        for (int dx = -1; dx <= 2; ++dx) {
+            ivec2 q = 2 * p + ivec2(dx, dy);
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
             vec4 qp = texelFetch(gbuffer_position, q, 0);
             if (qp.w <= 0.0) continue;
@@ -66,11 +75,6 @@ void level_zero(ivec2 p) {
             hi = max(hi, v);
         }
     }
-    imageStore(dst_mean, p, pos);
-    imageStore(dst_normal, p, vec4(n, 1.0));
-    imageStore(dst_min, p, lo);
-    imageStore(dst_max, p, hi);
-    imageStore(dst_flags, p, uvec4(GEO_HAS_GEOMETRY | GEO_SMOOTH));  // level 0 is always smooth
 }
 
 void coarser_level(ivec2 p) {
@@ -84,9 +88,12 @@ void coarser_level(ivec2 p) {
         mean += cn.w * imageLoad(src_mean, c);
         normal += cn.w * cn.xyz;
         coverage += cn.w;
-        lo = min(lo, imageLoad(src_min, c));
-        hi = max(hi, imageLoad(src_max, c));
+        if (level >= 2) {
+            lo = min(lo, imageLoad(src_min, c));
+            hi = max(hi, imageLoad(src_max, c));
+        }
     }
+    if (level == 1) level_one_ranges(p, lo, hi);
     uint flags = 0u;
     if (coverage > 0.0) {
         mean /= coverage;

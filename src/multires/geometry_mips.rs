@@ -27,19 +27,42 @@ impl GeometryMipsPass {
                     Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                     Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
                 ];
-                // Level 0 has no source level; its source bindings are unused.
-                let src = l.saturating_sub(1);
+                // Mean, normal and flags chains hold levels 0..=L; the range
+                // chains levels 1..=L (mip m is level m + 1). Bindings a level
+                // does not use (level 0's sources and ranges, level 1's source
+                // ranges) point at a mip it does not write.
+                let unused_range = |dst: usize| if dst == 0 { m.levels as usize - 1 } else { 0 };
+                let range_dst = l.saturating_sub(1);
+                let (src, dst): (Vec<usize>, Vec<usize>) = images
+                    .iter()
+                    .enumerate()
+                    .map(|(k, _)| {
+                        if k == 2 || k == 3 {
+                            let src = if l >= 2 {
+                                l - 2
+                            } else {
+                                unused_range(range_dst)
+                            };
+                            let dst = if l >= 1 { range_dst } else { unused_range(0) };
+                            (src, dst)
+                        } else {
+                            (l.saturating_sub(1), l)
+                        }
+                    })
+                    .unzip();
                 b.extend(
                     images
                         .iter()
                         .zip(SOURCES)
-                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[src])),
+                        .zip(&src)
+                        .map(|((i, name), &mip)| Binding::storage_image(name, i.mip_views[mip])),
                 );
                 b.extend(
                     images
                         .iter()
                         .zip(DESTINATIONS)
-                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[l])),
+                        .zip(&dst)
+                        .map(|((i, name), &mip)| Binding::storage_image(name, i.mip_views[mip])),
                 );
                 b
             })

@@ -24,6 +24,7 @@ pub struct MultiresBuffer {
     pub levels: u32,
     pub geo_mean: Image,
     pub geo_normal: Image,
+    /// Depth and normal-component ranges of levels 1..=L (mip m is level m + 1).
     pub geo_min: Image,
     pub geo_max: Image,
     pub geo_flags: Image,
@@ -104,13 +105,31 @@ impl MultiresBuffer {
                 },
             )
         };
+        // Depth and normal ranges start at level 1 (level 0's come from the
+        // G-buffer directly): mip m of these chains is level m + 1.
+        let range_chain = |name| {
+            Image::new(
+                gpu,
+                &ImageDesc {
+                    name,
+                    format: vk::Format::R32G32B32A32_SFLOAT,
+                    extent: vk::Extent2D {
+                        width: width >> 1,
+                        height: height >> 1,
+                    },
+                    layers: 1,
+                    mips: levels,
+                    usage: storage,
+                },
+            )
+        };
         let rgba = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Self {
             levels,
             geo_mean: mip_chain("geo_mean", rgba)?,
             geo_normal: mip_chain("geo_normal", rgba)?,
-            geo_min: mip_chain("geo_min", rgba)?,
-            geo_max: mip_chain("geo_max", rgba)?,
+            geo_min: range_chain("geo_min")?,
+            geo_max: range_chain("geo_max")?,
             geo_flags: mip_chain("geo_flags", vk::Format::R32_UINT)?,
             illumination: layered(
                 "illumination",
