@@ -37,9 +37,14 @@ fn run(gpu: &Gpu, label: &str, s: &RenderSettings, frames: u32) -> anyhow::Resul
 
 fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(&GpuOptions::default())?;
+    // ISR_BENCH_SIZE=256 for a quicker run.
+    let size: u32 = std::env::var("ISR_BENCH_SIZE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(512);
     let base = RenderSettings {
-        width: 512,
-        height: 512,
+        width: size,
+        height: size,
         rsm_resolution: 256,
         ..Default::default()
     };
@@ -56,7 +61,7 @@ fn main() -> anyhow::Result<()> {
         1,
     )?;
     let mut runs = Vec::new();
-    for n in [256, 1024, 4096] {
+    for n in [256u32; 0] {
         runs.push(run(
             &gpu,
             &format!("multires-gather {n}"),
@@ -70,7 +75,7 @@ fn main() -> anyhow::Result<()> {
         &with(Method::Isr, 256, Default::default()),
         3,
     )?);
-    for tau in [0.2, 0.05, 0.01] {
+    for tau in [0.5, 0.2, 0.05, 0.01, 0.002] {
         let lt = LightTreeSettings {
             tau,
             ..Default::default()
@@ -108,7 +113,7 @@ fn main() -> anyhow::Result<()> {
     std::fs::write(
         dir.join("light_space.json"),
         serde_json::to_string_pretty(
-            &json!({"device": gpu.info.name, "width": 512, "height": 512, "rsm": 256, "runs": rows}),
+            &json!({"device": gpu.info.name, "width": size, "height": size, "rsm": 256, "runs": rows}),
         )?,
     )?;
     Ok(())

@@ -25,6 +25,7 @@ layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // mip chain
 layout(set = 1, binding = 3) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 4) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 5) uniform sampler2D rsm_flux;
+// Basic ISR's chosen list, or HISR's packed quadtree (light_tree_pack.comp).
 layout(set = 1, binding = 6, std430) readonly buffer ChosenPatches {
     uint patch_count;
     uint pad0, pad1, pad2;
@@ -75,13 +76,28 @@ void chosen_list(vec3 xi, vec3 ni) {
 // constant per frame (light_tree.x; `--tau` is tau / I, so T = 2 (1 - tau) /
 // (3 tau R^2)). The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
-// R^2 / 4^k and its threshold 4^k T. Invalid patches (spanning a
-// discontinuity) are always subdivided.
+// R^2 / 4^k and its threshold 4^k T.
+//
+// Invalid patches (spanning a discontinuity) are held to a tighter test: the
+// bound above drops both cosines, so it holds for them too, but their mean
+// position and normal can misplace their whole contribution, where a valid
+// patch's misplace only a small part of it. An invalid patch is split while
+// its bound could exceed tau * HISR_INVALID_TAU_SCALE, i.e. against the
+// threshold T / HISR_INVALID_TAU_SCALE (for small tau). Splitting them always
+// costs about 520 evaluations per fragment in the Cornell box whatever tau
+// is; docs/algorithm.md section 4.3 has the measurements behind the scale.
 //
 // Depth-first with a fixed stack and no recursion; children are pushed only
-// above the max depth and when they fit, so every fetch is inside the quadtree
-// (a full stack evaluates the patch instead of splitting it).
-const int STACK_SIZE = 64;
+// above the max depth and when they fit, so every read is inside the tree
+// (a full stack evaluates the patch instead of splitting it). Depth d holds
+// 2^d x 2^d patches and the tree is at most 12 deep (RSM 4096), so the stack
+// holds at most 3 per depth plus the root: 40 entries.
+//
+// The nodes come from the packed tree (light_tree_pack.comp, bound as
+// ChosenPatches): node (x, y) of depth d is patches[(4^d - 1) / 3 + y 2^d + x].
+const int STACK_SIZE = 40;
+
+int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
 
 void traverse(vec3 xi, vec3 ni) {
     int top = run.light_levels.w;  // mip of the single root patch
@@ -96,20 +112,21 @@ void traverse(vec3 xi, vec3 ni) {
         stack[sp++] = ivec3(s % side, s / side, start);
         while (sp > 0) {
             ivec3 node = stack[--sp];
-            int mip = top - node.z;
-            vec4 pos = texelFetch(rsm_position, node.xy, mip);
-            if (pos.w <= 0.0) continue;  // saw nothing
-            vec4 nrm = texelFetch(rsm_normal, node.xy, mip);
+            LightPatch lp = patches[node_index(node)];
+            if (lp.position_area.w <= 0.0) continue;  // saw nothing
             bool split = false;
             if (node.z < max_depth && sp + 4 <= STACK_SIZE) {
-                vec3 vij = pos.xyz - xi;
-                vec3 vj = pos.xyz - light;
-                split = nrm.w == PATCH_INVALID || dot(vij, vij) <= exp2(float(2 * mip)) * t_finest * dot(vj, vj);
+                int mip = top - node.z;
+                vec3 vij = lp.position_area.xyz - xi;
+                vec3 vj = lp.position_area.xyz - light;
+                float reach = exp2(float(2 * mip)) * t_finest * dot(vj, vj);
+                if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
+                split = dot(vij, vij) <= reach;
             }
             if (split) {
                 for (int i = 3; i >= 0; --i) stack[sp++] = ivec3(2 * node.xy + ivec2(i & 1, i >> 1), node.z + 1);
             } else {
-                add_patch(xi, ni, pos, nrm, texelFetch(rsm_flux, node.xy, mip).rgb);
+                add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
             }
         }
     }

@@ -52,14 +52,19 @@ const float PI = 3.14159265358979323846;
 // One light patch chosen by Basic ISR (a node of the RSM quadtree).
 struct LightPatch {
     vec4 position_area;  // xyz: area-weighted mean position (m); w: area A (m^2)
-    vec4 normal;         // xyz: unit mean normal; w: RSM quadtree level
+    vec4 normal;         // xyz: unit mean normal; w: RSM quadtree level (ISR's list) or
+                         // PATCH_* (HISR's packed tree)
     vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr)
 };
 
 // RSM quadtree normal.w: what a patch is.
 const float PATCH_EMPTY = 0.0;    // saw no geometry
 const float PATCH_VALID = 1.0;    // one surface: may stand for all its texels
-const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity: must be subdivided
+const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR never takes it whole)
+
+// HISR splits an invalid patch while its bound could exceed tau times this
+// (gather.frag, docs/algorithm.md section 4.3).
+const float HISR_INVALID_TAU_SCALE = 0.01;
 
 // hierarchy.w bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up

@@ -391,6 +391,14 @@ impl<'g> Renderer<'g> {
     }
 
     /// How many light patches Basic ISR chose in the last frame.
+    /// HISR's packed light tree, root first (`shaders/light_tree_pack.comp`).
+    pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
+        match self.method.packed_light_tree() {
+            Some(b) => Ok(Some(readback::read_chosen_patches(self.gpu, b)?)),
+            None => Ok(None),
+        }
+    }
+
     pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
         Ok(self.isr_chosen()?.map(|c| c.len() as u32))
     }

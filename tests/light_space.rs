@@ -276,3 +276,36 @@ fn stats_and_vpl_count_view_from_the_cli() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// HISR traverses the quadtree packed into one buffer: node (x, y) of depth d
+/// at (4^d - 1) / 3 + y 2^d + x holds exactly the quadtree texel of mip
+/// log2 R - d (position and area, normal and state, flux and solid angle).
+#[test]
+fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
+    let gpu = gpu();
+    let rsm = 32u32;
+    let s = settings(Method::Hisr, rsm, LightTreeSettings::default());
+    let mut r = isr::renderer::Renderer::new(&gpu, &cornell_box(), &s).unwrap();
+    r.render_frames(1, |_| {}).unwrap();
+    let packed = r.hisr_packed_tree().unwrap().expect("hisr packs its tree");
+    let m = r.readback_multires().unwrap().unwrap();
+    drop(r);
+    assert_validation_clean(&gpu);
+    let top = rsm.trailing_zeros() as usize;
+    assert_eq!(packed.len(), ((4 * rsm * rsm - 1) / 3) as usize);
+    let mut index = 0;
+    let mut lit = 0;
+    for d in 0..=top {
+        let side = 1usize << d;
+        let [pos, nrm, flux] = &m.rsm_tree[top - d];
+        for i in 0..side * side {
+            let n = &packed[index + i];
+            assert_eq!(n.position_area, pos[i], "depth {d} node {i} position");
+            assert_eq!(n.normal, nrm[i], "depth {d} node {i} normal");
+            assert_eq!(n.flux, flux[i], "depth {d} node {i} flux");
+            lit += (pos[i][3] > 0.0) as usize;
+        }
+        index += side * side;
+    }
+    assert!(lit > 100, "only {lit} nodes saw anything");
+}

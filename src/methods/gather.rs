@@ -8,7 +8,6 @@
 //! ([`LightPatches`]); [`MultiresMethod`] puts the passes of every method
 //! that works through the multiresolution buffer in order.
 
-use super::isr::IsrSelectPass;
 use super::IndirectMethod;
 use crate::frame::{FrameContext, Setup};
 use crate::multires::{Multires, MultiresBuffer};
@@ -43,7 +42,8 @@ pub struct GatherPass {
 }
 
 impl GatherPass {
-    /// `chosen` is Basic ISR's list (`None` for other sources). With
+    /// `chosen` is the light-space pass's buffer: Basic ISR's list or HISR's
+    /// packed tree (`None` for other sources). With
     /// `--stencil off` the pipeline has no stencil test (measurement baseline).
     pub fn new(
         setup: &Setup,
@@ -111,30 +111,48 @@ impl FillPass for GatherPass {
     }
 }
 
+/// A method's own light-space pass, recorded before the gather: Basic ISR's
+/// selection, HISR's tree packing. The gather reads its buffer as
+/// `ChosenPatches`.
+pub trait LightSpacePass {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler);
+    fn buffer(&self) -> &Buffer;
+    /// Basic ISR's chosen list (read back for `--stats` and tests).
+    fn chosen_list(&self) -> Option<&Buffer> {
+        None
+    }
+    /// HISR's packed light tree (read back by tests).
+    fn packed_tree(&self) -> Option<&Buffer> {
+        None
+    }
+}
+
 /// A method that works through the multiresolution buffer: `multires-gather`,
 /// `isr`, `hisr` and `multires-splat`. Geometry mips and stencil refinement,
-/// the method's own light-space pass (ISR's selection), the gather or splat,
-/// then upsampling.
+/// the method's own light-space pass, the gather or splat, then upsampling.
 pub struct MultiresMethod {
     pub multires: Multires,
-    /// Basic ISR's patch selection (method `isr` only).
-    pub isr: Option<IsrSelectPass>,
+    light_pass: Option<Box<dyn LightSpacePass>>,
     fill: Box<dyn FillPass>,
 }
 
 impl MultiresMethod {
     /// `fill` makes the pass that fills the buffer's patches, given the
-    /// buffer and ISR's chosen list (if `isr` is given).
+    /// buffer and the light-space pass's buffer (if there is one).
     pub fn new(
         setup: &Setup,
-        isr: Option<IsrSelectPass>,
+        light_pass: Option<Box<dyn LightSpacePass>>,
         fill: impl FnOnce(&Setup, &MultiresBuffer, Option<&Buffer>) -> Result<Box<dyn FillPass>>,
     ) -> Result<Self> {
         let multires = Multires::new(setup)?;
-        let fill = fill(setup, &multires.buffer, isr.as_ref().map(|i| &i.chosen))?;
+        let fill = fill(
+            setup,
+            &multires.buffer,
+            light_pass.as_ref().map(|l| l.buffer()),
+        )?;
         Ok(Self {
             multires,
-            isr,
+            light_pass,
             fill,
         })
     }
@@ -143,8 +161,8 @@ impl MultiresMethod {
 impl IndirectMethod for MultiresMethod {
     fn record(&self, ctx: &FrameContext, p: &mut Profiler, _: usize) {
         self.multires.record_refinement(ctx, p);
-        if let Some(isr) = &self.isr {
-            isr.record(ctx, p);
+        if let Some(l) = &self.light_pass {
+            l.record(ctx, p);
         }
         self.fill.record(ctx, p, &self.multires.buffer);
         self.multires.record_upsample(ctx, p);
@@ -155,6 +173,10 @@ impl IndirectMethod for MultiresMethod {
     }
 
     fn chosen_patches(&self) -> Option<&Buffer> {
-        self.isr.as_ref().map(|i| &i.chosen)
+        self.light_pass.as_ref().and_then(|l| l.chosen_list())
+    }
+
+    fn packed_light_tree(&self) -> Option<&Buffer> {
+        self.light_pass.as_ref().and_then(|l| l.packed_tree())
     }
 }

@@ -6,7 +6,7 @@
 //! Pass `isr-select`: `shaders/isr_select.comp`, one dispatch over the base
 //! level with an atomic append. Reads the RSM quadtree; writes the chosen list.
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod};
+use super::gather::{GatherPass, LightPatches, LightSpacePass, MultiresMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER};
 use crate::passes::{ComputePass, INDIRECT_COMPUTE};
@@ -21,7 +21,7 @@ use gpu_allocator::MemoryLocation;
 /// Method `isr`: the selection, then every eye-space patch gathers the list.
 pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     let select = IsrSelectPass::new(setup)?;
-    MultiresMethod::new(setup, Some(select), |setup, m, chosen| {
+    MultiresMethod::new(setup, Some(Box::new(select)), |setup, m, chosen| {
         Ok(Box::new(GatherPass::new(
             setup,
             m,
@@ -68,8 +68,18 @@ impl IsrSelectPass {
             base_extent,
         })
     }
+}
 
-    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+impl LightSpacePass for IsrSelectPass {
+    fn buffer(&self) -> &Buffer {
+        &self.chosen
+    }
+
+    fn chosen_list(&self) -> Option<&Buffer> {
+        Some(&self.chosen)
+    }
+
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         profiler.pass(gpu, cmd, "isr-select", INDIRECT_COMPUTE, || unsafe {

@@ -55,6 +55,12 @@ pub trait IndirectMethod {
     fn chosen_patches(&self) -> Option<&Buffer> {
         None
     }
+
+    /// HISR's packed light tree (`CHOSEN_PATCHES_HEADER`, then a `LightPatch`
+    /// per quadtree node, root first; see `shaders/light_tree_pack.comp`).
+    fn packed_light_tree(&self) -> Option<&Buffer> {
+        None
+    }
 }
 
 /// The method `setup.settings.method` names, made for `setup`.

@@ -1,0 +1,41 @@
+#version 460
+// Pass `light-tree-pack` (HISR, docs/algorithm.md section 4): copies the RSM
+// quadtree's mip chains into one storage buffer, a LightPatch per node, so the
+// per-fragment traversal reads a node with one contiguous load instead of
+// three texel fetches from three mip chains.
+//
+// Order: depth-major from the root. Depth d (2^d x 2^d patches, RSM mip
+// top - d) starts at node (4^d - 1) / 3, row-major inside: node (x, y) of depth
+// d is (4^d - 1) / 3 + y 2^d + x. One invocation per node, laid out R wide.
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
+layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
+layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
+layout(set = 1, binding = 3, std430) writeonly buffer LightTree {
+    uint count;  // nodes in the tree, (4 R^2 - 1) / 3
+    uint pad0, pad1, pad2;
+    LightPatch nodes[];
+};
+
+void main() {
+    int top = run.light_levels.w;  // mip of the root
+    int r = 1 << top;
+    int i = int(gl_GlobalInvocationID.y) * r + int(gl_GlobalInvocationID.x);
+    int total = (4 * r * r - 1) / 3;
+    if (gl_GlobalInvocationID.x >= uint(r) || i >= total) return;
+    if (i == 0) count = uint(total);
+    int node = i;
+    int d = 0;
+    while (node >= 1 << (2 * d)) {
+        node -= 1 << (2 * d);
+        ++d;
+    }
+    int side = 1 << d;
+    ivec2 xy = ivec2(node % side, node / side);
+    int mip = top - d;
+    nodes[i] = LightPatch(texelFetch(rsm_position, xy, mip), texelFetch(rsm_normal, xy, mip),
+                          texelFetch(rsm_flux, xy, mip));
+}
