@@ -92,7 +92,22 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     if !lo.is_finite() {
         return 0.1..1.0;
     }
+    // At least two powers of ten in range, so a log axis has labels.
+    if hi / lo < 10.0 {
+        lo = 10f64.powf(lo.log10().floor());
+        hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
+        return lo..hi;
+    }
     (lo / 1.5)..(hi * 1.5)
+}
+
+/// A tick label with two significant digits ("0.03", "120").
+fn short(v: f64) -> String {
+    if v <= 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (1 - v.log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
 }
 
 /// Panels of (x, y) curves, one per method over its sweep, log-log.
@@ -134,6 +149,10 @@ where
             .configure_mesh()
             .x_desc("indirect ms")
             .y_desc(y_label)
+            .x_labels(6)
+            .y_labels(6)
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
@@ -233,32 +252,29 @@ where
             .fold(1e-3f64, f64::max)
             * 1.1;
         let n = bars.len().max(1);
+        // Horizontal bars: method names fit on the left.
         let mut chart = ChartBuilder::on(panel)
             .caption(scene, ("sans-serif", 18))
             .margin(8)
-            .x_label_area_size(90)
-            .y_label_area_size(56)
-            .build_cartesian_2d(0f64..n as f64, 0f64..max)
+            .x_label_area_size(36)
+            .y_label_area_size(130)
+            .build_cartesian_2d(0f64..max, 0f64..n as f64)
             .map_err(|e| anyhow!("{e}"))?;
         let names: Vec<String> = bars.iter().map(|r| r.method.clone()).collect();
         chart
             .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n + 1)
-            .x_label_formatter(&|x| {
-                let i = x.floor() as usize;
-                if (x - i as f64 - 0.5).abs() < 0.26 || x.fract() == 0.0 {
+            .disable_y_mesh()
+            .y_labels(4 * n + 1)
+            .y_label_formatter(&|y| {
+                // One label at each bar's middle.
+                let i = y.floor() as usize;
+                if (y - i as f64 - 0.5).abs() < 0.01 {
                     names.get(i).cloned().unwrap_or_default()
                 } else {
                     String::new()
                 }
             })
-            .x_label_style(
-                ("sans-serif", 11)
-                    .into_font()
-                    .transform(FontTransform::Rotate90),
-            )
-            .y_desc("ms")
+            .x_desc("ms")
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
@@ -271,7 +287,7 @@ where
                     let ms = *r.passes.get(pass)?;
                     let below: f64 = passes[..pi].iter().filter_map(|p| r.passes.get(p)).sum();
                     Some(Rectangle::new(
-                        [(i as f64 + 0.15, below), (i as f64 + 0.85, below + ms)],
+                        [(below, i as f64 + 0.15), (below + ms, i as f64 + 0.85)],
                         color.filled(),
                     ))
                 })
@@ -289,7 +305,7 @@ where
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(SeriesLabelPosition::LowerRight)
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .label_font(("sans-serif", 10))
@@ -330,7 +346,7 @@ pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) ->
                 .iter()
                 .find(|r| &r.scene == s && r.method == *m && r.is_default);
             let label = match row {
-                Some(r) => format!("{m} ({}): RMSE {:.3}", r.label, r.rel_rmse_indirect),
+                Some(r) => format!("{m}\n{}, RMSE {:.3}", r.label, r.rel_rmse_indirect),
                 None => format!("{m}: not run"),
             };
             top.push((label, load(&images.join(format!("{m}.png")))));
@@ -351,7 +367,7 @@ pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) ->
     // Small renders are shown enlarged so labels fit.
     let scale = (240 / cw).max(1);
     let (tw, th) = (cw * scale, ch * scale);
-    let label_h = 18;
+    let label_h = 32;
     let cols = cells.iter().map(Vec::len).max().unwrap_or(1) as u32;
     let (w, h) = (
         cols * (tw + 4) + 4,
@@ -379,12 +395,14 @@ pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) ->
         for (ri, row) in cells.iter().enumerate() {
             for (ci, (label, _)) in row.iter().enumerate() {
                 let (x0, y0) = (4 + ci as u32 * (tw + 4), 4 + ri as u32 * (th + label_h + 4));
-                root.draw(&Text::new(
-                    label.clone(),
-                    (x0 as i32, y0 as i32 + 2),
-                    ("sans-serif", 12).into_font().color(&BLACK),
-                ))
-                .map_err(|e| anyhow!("gallery: {e}"))?;
+                for (li, line) in label.lines().enumerate() {
+                    root.draw(&Text::new(
+                        line.to_string(),
+                        (x0 as i32, y0 as i32 + 2 + 15 * li as i32),
+                        ("sans-serif", 12).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| anyhow!("gallery: {e}"))?;
+                }
             }
         }
         root.present().map_err(|e| anyhow!("gallery: {e}"))?;
