@@ -469,6 +469,17 @@ fn run_scene(
         row.flicker_final = flicker_final.flicker();
         row.light_patch_evals = evals;
         row.gpu_memory_bytes = memory;
+        if bar.is_hidden() {
+            // No terminal (a log, CI): one line per finished row instead.
+            eprintln!(
+                "{}: {} {}: {:.1} ms indirect, relative RMSE {:.4}",
+                row.scene,
+                row.method,
+                row.label,
+                row.indirect_ms.unwrap_or(f64::NAN),
+                row.rel_rmse_indirect
+            );
+        }
         rows::append(journal, &row)?;
     }
     Ok(())
