@@ -7,6 +7,7 @@
 //! per indirect method), `multires` (the eye-space hierarchy), `vk` (device,
 //! resources, barriers, pipelines, timing), `scene`. The README has the map.
 
+pub mod bench;
 pub mod cli;
 pub mod debug_view;
 pub mod frame;

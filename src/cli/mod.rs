@@ -31,6 +31,9 @@ enum Command {
     /// Render a scene headless and write EXR, PNG and per-pass GPU timings.
     #[command(allow_negative_numbers = true)]
     Render(Box<RenderArgs>),
+    /// Every method over its parameter sweep on the stress scenes, against
+    /// the dense reference: results.json/.csv, charts, gallery, report.md.
+    Bench(Box<crate::bench::BenchArgs>),
     /// List the Vulkan devices (the index is what --device takes).
     Devices,
     /// Write the built-in Cornell box as a glTF file.
@@ -308,6 +311,7 @@ pub fn run() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Render(args) => render(*args),
+        Command::Bench(args) => crate::bench::cli(&args),
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {
             let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;

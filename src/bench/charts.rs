@@ -1,0 +1,415 @@
+//! The bench's charts (plotters; each drawn once to SVG and once to PNG from
+//! the same code) and the gallery. Text uses DejaVu Sans compiled into the
+//! binary (`dejavu` crate), registered with plotters' ab_glyph backend, so no
+//! system font is needed.
+
+use super::rows::Row;
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Registers the embedded font as "sans-serif" (once; later calls do nothing).
+pub fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The font is a valid TTF shipped by the crate; failure would only
+        // mean text is not drawn, so it is not fatal.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
+    });
+}
+
+/// A fixed colour per method, the same in every chart.
+pub fn method_color(method: &str) -> RGBColor {
+    match method {
+        "rsm-gather" => RGBColor(120, 120, 120),
+        "rsm-splat" => RGBColor(140, 86, 75),
+        "rsm-splat-restricted" => RGBColor(227, 119, 194),
+        "multires-splat" => RGBColor(255, 127, 14),
+        "multires-gather" => RGBColor(31, 119, 180),
+        "isr" => RGBColor(44, 160, 44),
+        "hisr" => RGBColor(214, 39, 40),
+        _ => RGBColor(0, 0, 0),
+    }
+}
+
+/// Black, red, yellow, white as FLIP rises from 0 to 1 (RGBA8).
+pub fn heat_map(values: &[f32]) -> Vec<u8> {
+    values
+        .iter()
+        .flat_map(|&v| {
+            let v = v.clamp(0.0, 1.0) * 3.0;
+            let c = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+            [c(v), c(v - 1.0), c(v - 2.0), 255]
+        })
+        .collect()
+}
+
+type Draw<'a> = dyn Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()> + 'a;
+type DrawPng<'a> = dyn Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<()> + 'a;
+
+/// Draws a chart to `stem.svg` and `stem.png` (the same function for both
+/// backends, written atomically).
+fn both(stem: &Path, size: (u32, u32), svg: &Draw, png: &DrawPng) -> Result<()> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        svg(&root)?;
+        root.present()
+            .map_err(|e| anyhow!("drawing {}: {e}", stem.display()))?;
+    }
+    crate::output::write_text(&stem.with_extension("svg"), &text)?;
+    let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        png(&root)?;
+        root.present()
+            .map_err(|e| anyhow!("drawing {}: {e}", stem.display()))?;
+    }
+    let rgba: Vec<u8> = rgb
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    crate::output::write_png(&stem.with_extension("png"), size.0, size.1, &rgba)
+}
+
+/// Grid of (rows, columns) for `n` panels.
+fn grid(n: usize) -> (usize, usize) {
+    let cols = n.clamp(1, 3);
+    (n.div_ceil(cols).max(1), cols)
+}
+
+fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for v in values.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return 0.1..1.0;
+    }
+    // At least two powers of ten in range, so a log axis has labels.
+    if hi / lo < 10.0 {
+        lo = 10f64.powf(lo.log10().floor());
+        hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
+        return lo..hi;
+    }
+    (lo / 1.5)..(hi * 1.5)
+}
+
+/// A tick label with two significant digits ("0.03", "120").
+fn short(v: f64) -> String {
+    if v <= 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (1 - v.log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
+/// Panels of (x, y) curves, one per method over its sweep, log-log.
+fn curves<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    scenes: &[String],
+    title: &str,
+    y_label: &str,
+    y: &dyn Fn(&Row) -> Option<f64>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(|e| anyhow!("{e}"))?;
+    let (r, c) = grid(scenes.len());
+    let panels = root.split_evenly((r, c));
+    for (scene, panel) in scenes.iter().zip(panels.iter()) {
+        let pts: Vec<&Row> = rows
+            .iter()
+            .filter(|row| &row.scene == scene && row.method != "reference")
+            .filter(|row| {
+                row.indirect_ms.is_some_and(|v| v > 0.0) && y(row).is_some_and(|v| v > 0.0)
+            })
+            .collect();
+        let xr = log_range(pts.iter().filter_map(|r| r.indirect_ms));
+        let yr = log_range(pts.iter().filter_map(|r| y(r)));
+        let mut chart = ChartBuilder::on(panel)
+            .caption(scene, ("sans-serif", 18))
+            .margin(8)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc("indirect ms")
+            .y_desc(y_label)
+            .x_labels(6)
+            .y_labels(6)
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        let mut methods: Vec<&str> = vec![];
+        for p in &pts {
+            if !methods.contains(&p.method.as_str()) {
+                methods.push(&p.method);
+            }
+        }
+        for m in methods {
+            let color = method_color(m);
+            let mut line: Vec<(f64, f64)> = pts
+                .iter()
+                .filter(|p| p.method == m)
+                .filter_map(|p| Some((p.indirect_ms?, y(p)?)))
+                .collect();
+            line.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
+                .map_err(|e| anyhow!("{e}"))?
+                .label(m)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 11))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
+}
+
+/// `speed_vs_error.svg/.png`: indirect ms against relative RMSE of the
+/// indirect image, one panel per scene (section 6.5).
+pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
+    let (r, c) = grid(scenes.len());
+    let size = (480 * c as u32, 400 * r as u32 + 40);
+    let title = "indirect time against error (log-log; lower left is better)";
+    let y = |r: &Row| Some(r.rel_rmse_indirect);
+    both(
+        &dir.join("speed_vs_error"),
+        size,
+        &|a| curves(a, rows, scenes, title, "relative RMSE (indirect)", &y),
+        &|a| curves(a, rows, scenes, title, "relative RMSE (indirect)", &y),
+    )
+}
+
+/// `flicker.svg/.png`: flicker (section 6.3) against indirect ms.
+pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
+    let (r, c) = grid(scenes.len());
+    let size = (480 * c as u32, 400 * r as u32 + 40);
+    let title = "flicker against indirect time (log-log; lower left is better)";
+    let y = |r: &Row| r.flicker;
+    both(
+        &dir.join("flicker"),
+        size,
+        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y),
+        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y),
+    )
+}
+
+/// Stacked per-pass times of each method at its default, one panel per scene.
+fn stacked<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    scenes: &[String],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+    let root = root
+        .titled(
+            "per-pass GPU time at each method's default (median ms)",
+            ("sans-serif", 22),
+        )
+        .map_err(|e| anyhow!("{e}"))?;
+    let (r, c) = grid(scenes.len());
+    let panels = root.split_evenly((r, c));
+    let passes = super::rows::pass_names(rows);
+    let palette = |i: usize| Palette99::pick(i).to_rgba();
+    for (scene, panel) in scenes.iter().zip(panels.iter()) {
+        let bars: Vec<&Row> = rows
+            .iter()
+            .filter(|r| &r.scene == scene && r.is_default && r.method != "reference")
+            .collect();
+        let max = bars
+            .iter()
+            .filter_map(|r| r.total_ms)
+            .fold(1e-3f64, f64::max)
+            * 1.1;
+        let n = bars.len().max(1);
+        // Horizontal bars: method names fit on the left.
+        let mut chart = ChartBuilder::on(panel)
+            .caption(scene, ("sans-serif", 18))
+            .margin(8)
+            .x_label_area_size(36)
+            .y_label_area_size(130)
+            .build_cartesian_2d(0f64..max, 0f64..n as f64)
+            .map_err(|e| anyhow!("{e}"))?;
+        let names: Vec<String> = bars.iter().map(|r| r.method.clone()).collect();
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(4 * n + 1)
+            .y_label_formatter(&|y| {
+                // One label at each bar's middle.
+                let i = y.floor() as usize;
+                if (y - i as f64 - 0.5).abs() < 0.01 {
+                    names.get(i).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_desc("ms")
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        for (pi, pass) in passes.iter().enumerate() {
+            let color = palette(pi);
+            let rects: Vec<Rectangle<(f64, f64)>> = bars
+                .iter()
+                .enumerate()
+                .filter_map(|(i, r)| {
+                    let ms = *r.passes.get(pass)?;
+                    let below: f64 = passes[..pi].iter().filter_map(|p| r.passes.get(p)).sum();
+                    Some(Rectangle::new(
+                        [(below, i as f64 + 0.15), (below + ms, i as f64 + 0.85)],
+                        color.filled(),
+                    ))
+                })
+                .collect();
+            if rects.is_empty() {
+                continue;
+            }
+            chart
+                .draw_series(rects)
+                .map_err(|e| anyhow!("{e}"))?
+                .label(pass.as_str())
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 10, y + 5)], color.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 10))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
+}
+
+/// `passes.svg/.png`.
+pub fn passes(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
+    let (r, c) = grid(scenes.len());
+    let size = (480 * c as u32, 460 * r as u32 + 40);
+    both(
+        &dir.join("passes"),
+        size,
+        &|a| stacked(a, rows, scenes),
+        &|a| stacked(a, rows, scenes),
+    )
+}
+
+/// `gallery.png`: per scene two rows, every method's image at its default
+/// (the middle animation frame) and its FLIP heat map against the reference,
+/// with the reference first; labelled with method and error.
+pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) -> Result<()> {
+    let load = |p: &Path| -> Option<image::RgbaImage> { Some(image::open(p).ok()?.to_rgba8()) };
+    let mut cells: Vec<Vec<(String, Option<image::RgbaImage>)>> = vec![];
+    let (mut cw, mut ch) = (64u32, 64u32);
+    for s in scenes {
+        let images = dir.join("images").join(s);
+        let mut top = vec![(
+            format!("{s}: reference"),
+            load(&images.join("reference.png")),
+        )];
+        let mut bottom = vec![("FLIP: black 0, white 1".to_string(), None)];
+        for m in methods {
+            let row = rows
+                .iter()
+                .find(|r| &r.scene == s && r.method == *m && r.is_default);
+            let label = match row {
+                Some(r) => format!("{m}\n{}, RMSE {:.3}", r.label, r.rel_rmse_indirect),
+                None => format!("{m}: not run"),
+            };
+            top.push((label, load(&images.join(format!("{m}.png")))));
+            let flip = row
+                .map(|r| format!("FLIP {:.3}", r.flip))
+                .unwrap_or_default();
+            bottom.push((flip, load(&images.join(format!("{m}-error.png")))));
+        }
+        for (_, img) in top.iter().chain(&bottom) {
+            if let Some(i) = img {
+                cw = cw.max(i.width());
+                ch = ch.max(i.height());
+            }
+        }
+        cells.push(top);
+        cells.push(bottom);
+    }
+    // Small renders are shown enlarged so labels fit.
+    let scale = (240 / cw).max(1);
+    let (tw, th) = (cw * scale, ch * scale);
+    let label_h = 32;
+    let cols = cells.iter().map(Vec::len).max().unwrap_or(1) as u32;
+    let (w, h) = (
+        cols * (tw + 4) + 4,
+        cells.len() as u32 * (th + label_h + 4) + 4,
+    );
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    for (ri, row) in cells.iter().enumerate() {
+        for (ci, (_, img)) in row.iter().enumerate() {
+            let Some(img) = img else { continue };
+            let (x0, y0) = (
+                4 + ci as u32 * (tw + 4),
+                4 + ri as u32 * (th + label_h + 4) + label_h,
+            );
+            for y in 0..img.height() * scale {
+                for x in 0..img.width() * scale {
+                    let p = img.get_pixel(x / scale, y / scale);
+                    let o = (((y0 + y) * w + x0 + x) * 3) as usize;
+                    rgb[o..o + 3].copy_from_slice(&p.0[..3]);
+                }
+            }
+        }
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        for (ri, row) in cells.iter().enumerate() {
+            for (ci, (label, _)) in row.iter().enumerate() {
+                let (x0, y0) = (4 + ci as u32 * (tw + 4), 4 + ri as u32 * (th + label_h + 4));
+                for (li, line) in label.lines().enumerate() {
+                    root.draw(&Text::new(
+                        line.to_string(),
+                        (x0 as i32, y0 as i32 + 2 + 15 * li as i32),
+                        ("sans-serif", 12).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| anyhow!("gallery: {e}"))?;
+                }
+            }
+        }
+        root.present().map_err(|e| anyhow!("gallery: {e}"))?;
+    }
+    let rgba: Vec<u8> = rgb
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    crate::output::write_png(&dir.join("gallery.png"), w, h, &rgba)
+}

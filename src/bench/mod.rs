@@ -1,0 +1,581 @@
+//! `isr bench`: every method over its parameter sweep on the stress scenes,
+//! against the dense reference of the same frame (docs/algorithm.md section
+//! 6), written as `results.json`, `results.csv`, charts, a gallery and
+//! `report.md` into one folder. Rows are journalled to `rows.jsonl` as they
+//! finish, so an interrupted run resumes where it stopped.
+
+pub mod charts;
+pub mod flip;
+pub mod metrics;
+pub mod report;
+pub mod rows;
+pub mod scenes;
+pub mod sweep;
+
+use crate::readback::Readback;
+use crate::renderer::{FrameStats, Renderer};
+use crate::scene::Scene;
+use crate::settings::{Method, RenderSettings};
+use crate::vk::{Gpu, GpuOptions};
+use anyhow::{bail, Context as _, Result};
+use rows::Row;
+use std::path::{Path, PathBuf};
+use sweep::Config;
+
+/// What `isr bench` runs (the CLI's flags; `cargo bench` fills it in code).
+#[derive(clap::Args, Clone, Debug)]
+pub struct BenchArgs {
+    /// Scenes (comma-separated): bench scene names (see `scenes::SCENES`) or
+    /// paths to .gltf/.glb files. Default: all bench scenes (quick: cornell, slats).
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    pub scenes: Vec<String>,
+    /// Methods to sweep (comma-separated). Default: every method but the references.
+    #[arg(long, value_enum, value_delimiter = ',', num_args = 1..)]
+    pub methods: Vec<Method>,
+    /// Image width (default 128; quick 64).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default 128; quick 64).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// RSM resolution (default 128; quick 64).
+    #[arg(long)]
+    pub rsm: Option<u32>,
+    /// Animation frames per scene, 1/fps apart (default 6; quick 3).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Frames rendered for timing at the first animation frame (default 3; quick 2).
+    #[arg(long)]
+    pub timing_frames: Option<u32>,
+    /// Where the results go; a run resumes from the rows already there.
+    #[arg(long, default_value = "out/bench")]
+    pub out_dir: PathBuf,
+    /// The CI smoke test: two small scenes, a few settings per method, 64x64.
+    #[arg(long)]
+    pub quick: bool,
+    /// Vulkan device index (`isr devices`).
+    #[arg(long)]
+    pub device: Option<usize>,
+}
+
+impl Default for BenchArgs {
+    fn default() -> Self {
+        Self {
+            scenes: vec![],
+            methods: vec![],
+            width: None,
+            height: None,
+            rsm: None,
+            frames: None,
+            timing_frames: None,
+            out_dir: "out/bench".into(),
+            quick: false,
+            device: None,
+        }
+    }
+}
+
+/// The resolved plan of a run.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub scenes: Vec<SceneSpec>,
+    pub methods: Vec<Method>,
+    pub base: RenderSettings,
+    pub frames: u32,
+    pub timing_frames: u32,
+    pub quick: bool,
+    pub out_dir: PathBuf,
+    pub device: Option<usize>,
+}
+
+/// A scene of the run: its name, how it is made and its animation window.
+#[derive(Clone, Debug)]
+pub struct SceneSpec {
+    pub name: String,
+    pub file: Option<PathBuf>,
+    pub start: f32,
+    pub fps: f32,
+}
+
+impl SceneSpec {
+    fn load(&self) -> Result<Scene> {
+        match &self.file {
+            Some(p) => crate::scene::gltf_load::load_with(p, &Default::default()),
+            None => scenes::build(&self.name),
+        }
+    }
+}
+
+impl BenchArgs {
+    /// Checks the flags and fills in the defaults; bad input is an error
+    /// that names the valid values.
+    pub fn plan(&self) -> Result<Plan> {
+        let q = self.quick;
+        let names: Vec<String> = if self.scenes.is_empty() {
+            let d: &[&str] = if q {
+                &["cornell", "slats"]
+            } else {
+                &["cornell", "fine", "hall", "slats", "moving-block"]
+            };
+            d.iter().map(|s| s.to_string()).collect()
+        } else {
+            self.scenes.clone()
+        };
+        let mut specs = vec![];
+        for n in names {
+            let lower = n.to_ascii_lowercase();
+            if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+                let path = PathBuf::from(&n);
+                if !path.is_file() {
+                    bail!("scene file {n} does not exist");
+                }
+                let name = path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or(n.clone());
+                specs.push(SceneSpec {
+                    name,
+                    file: Some(path),
+                    start: 0.0,
+                    fps: 10.0,
+                });
+            } else {
+                let s = scenes::find(&n)?;
+                specs.push(SceneSpec {
+                    name: s.name.into(),
+                    file: None,
+                    start: s.start,
+                    fps: s.fps,
+                });
+            }
+        }
+        let methods = if self.methods.is_empty() {
+            sweep::METHODS.to_vec()
+        } else {
+            for m in &self.methods {
+                if !sweep::METHODS.contains(m) {
+                    let valid: Vec<&str> = sweep::METHODS.iter().map(|m| m.name()).collect();
+                    bail!(
+                        "method '{}' has no sweep (the dense reference renders once per scene and frame by itself); choose from: {}",
+                        m.name(),
+                        valid.join(", ")
+                    );
+                }
+            }
+            self.methods.clone()
+        };
+        let small = if q { 64 } else { 128 };
+        let (width, height) = (self.width.unwrap_or(small), self.height.unwrap_or(small));
+        let rsm = self.rsm.unwrap_or(small);
+        if !(8..=4096).contains(&width) || !(8..=4096).contains(&height) {
+            bail!("--width and --height must be within 8..=4096 (got {width}x{height})");
+        }
+        if !rsm.is_power_of_two() || !(8..=4096).contains(&rsm) {
+            bail!("--rsm {rsm}: the RSM resolution must be a power of two within 8..=4096");
+        }
+        let frames = self.frames.unwrap_or(if q { 3 } else { 6 });
+        let timing_frames = self.timing_frames.unwrap_or(if q { 2 } else { 3 });
+        if frames == 0 || frames > 1000 || timing_frames == 0 || timing_frames > 1000 {
+            bail!("--frames and --timing-frames must be within 1..=1000");
+        }
+        Ok(Plan {
+            scenes: specs,
+            methods,
+            base: RenderSettings {
+                width,
+                height,
+                rsm_resolution: rsm,
+                ..RenderSettings::DEFAULT
+            },
+            frames,
+            timing_frames,
+            quick: q,
+            out_dir: self.out_dir.clone(),
+            device: self.device,
+        })
+    }
+}
+
+impl Plan {
+    /// The sweep points of every method.
+    pub fn configs(&self) -> Vec<Config> {
+        self.methods
+            .iter()
+            .flat_map(|&m| sweep::sweep(m, self.base.rsm_resolution, self.quick))
+            .collect()
+    }
+
+    /// The journal key of a row.
+    pub fn key(&self, scene: &str, method: &str, label: &str) -> String {
+        let b = &self.base;
+        format!(
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed",
+            b.width, b.height, b.rsm_resolution, self.frames, self.timing_frames
+        )
+    }
+
+    /// Every key this run produces, in report order.
+    pub fn keys(&self) -> Vec<String> {
+        let mut keys = vec![];
+        for s in &self.scenes {
+            keys.push(self.key(&s.name, Method::Reference.name(), REFERENCE_LABEL));
+            for c in self.configs() {
+                keys.push(self.key(&s.name, c.method.name(), &c.label(&self.base)));
+            }
+        }
+        keys
+    }
+}
+
+const REFERENCE_LABEL: &str = "every RSM texel";
+
+/// One frame of the dense reference, what every method is compared with.
+struct RefFrame {
+    indirect: Vec<[f32; 4]>,
+    final_radiance: Vec<[f32; 4]>,
+    mask: Vec<bool>,
+    display: Vec<u8>,
+}
+
+/// The total the GPU allocator has handed out, in bytes.
+fn allocated_bytes(gpu: &Gpu) -> Option<i64> {
+    let a = gpu.shared.allocator.lock().ok()?;
+    Some(a.generate_report().total_allocated_bytes as i64)
+}
+
+/// What a finished run returns (the rows of this plan, in order).
+pub struct Outcome {
+    pub rows: Vec<Row>,
+    pub device: String,
+    pub driver: String,
+}
+
+/// Runs the plan: renders what the journal lacks, then writes every output.
+pub fn run(plan: &Plan) -> Result<Outcome> {
+    let dir = &plan.out_dir;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let journal = dir.join("rows.jsonl");
+    let done = rows::done_keys(&rows::read_journal(&journal)?);
+    let gpu = Gpu::new(&GpuOptions {
+        device_index: plan.device,
+        ..Default::default()
+    })?;
+    crate::bench::charts::register_font();
+    // Work units: one per frame rendered (reference and every pending point).
+    let configs = plan.configs();
+    let mut pending: Vec<(SceneSpec, Vec<Config>, bool)> = vec![];
+    let mut units = 0u64;
+    for s in &plan.scenes {
+        let todo: Vec<Config> = configs
+            .iter()
+            .filter(|c| !done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base))))
+            .cloned()
+            .collect();
+        let ref_row = !done.contains(&plan.key(&s.name, "reference", REFERENCE_LABEL));
+        if todo.is_empty() && !ref_row {
+            continue;
+        }
+        units += plan.frames as u64 * (todo.len() as u64 + 1);
+        pending.push((s.clone(), todo, ref_row));
+    }
+    let bar = indicatif::ProgressBar::new(units);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "[{elapsed_precise}] {bar:30} {pos}/{len} frames, {eta} left: {msg}",
+        )
+        .expect("the progress template is valid"),
+    );
+    for (spec, todo, ref_row) in &pending {
+        let scene = spec.load()?;
+        run_scene(plan, &gpu, spec, &scene, todo, *ref_row, &journal, &bar)?;
+    }
+    bar.finish_and_clear();
+    let all = rows::read_journal(&journal)?;
+    let rows: Vec<Row> = plan
+        .keys()
+        .iter()
+        .filter_map(|k| all.iter().rev().find(|r| &r.key == k).cloned())
+        .collect();
+    let outcome = Outcome {
+        rows,
+        device: gpu.info.name.clone(),
+        driver: gpu.info.driver.clone(),
+    };
+    report::write_all(plan, &outcome)?;
+    Ok(outcome)
+}
+
+/// `isr bench`: plans, runs, prints where the results are and the ratios.
+pub fn cli(args: &BenchArgs) -> Result<()> {
+    let plan = args.plan()?;
+    let outcome = run(&plan)?;
+    println!("{}", report::ratios_text(&report::ratios(&outcome.rows)));
+    println!(
+        "wrote results.json, results.csv, charts, gallery.png and report.md to {}",
+        plan.out_dir.display()
+    );
+    Ok(())
+}
+
+/// Animation time of frame `k`.
+fn frame_time(spec: &SceneSpec, k: u32) -> f32 {
+    spec.start + k as f32 / spec.fps
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_scene(
+    plan: &Plan,
+    gpu: &Gpu,
+    spec: &SceneSpec,
+    scene: &Scene,
+    todo: &[Config],
+    ref_row: bool,
+    journal: &Path,
+    bar: &indicatif::ProgressBar,
+) -> Result<()> {
+    let images = plan.out_dir.join("images").join(&spec.name);
+    // The dense reference of every frame, once.
+    let mut refs = Vec::with_capacity(plan.frames as usize);
+    let mut ref_stats = FrameStats::default();
+    {
+        let settings = RenderSettings {
+            method: Method::Reference,
+            ..plan.base.clone()
+        };
+        let mut r = Renderer::new(gpu, scene, &settings)?;
+        for k in 0..plan.frames {
+            bar.set_message(format!(
+                "{}: reference, frame {}/{}",
+                spec.name,
+                k + 1,
+                plan.frames
+            ));
+            r.update(&scene.state_at(frame_time(spec, k)))?;
+            let stats = r.render_frames(1, |_| {})?;
+            ref_stats.frames.extend(stats.frames);
+            let out = r.readback()?;
+            if k == plan.frames / 2 {
+                crate::output::write_png(
+                    &images.join("reference.png"),
+                    out.width,
+                    out.height,
+                    &out.display,
+                )?;
+            }
+            refs.push(RefFrame {
+                mask: metrics::geometry_mask(&out.position),
+                indirect: out.indirect,
+                final_radiance: out.final_radiance,
+                display: out.display,
+            });
+            bar.inc(1);
+        }
+    }
+    if ref_row {
+        let mut row = timing_row(
+            plan,
+            spec,
+            &settings_of(plan, Method::Reference),
+            &ref_stats,
+        );
+        row.label = REFERENCE_LABEL.into();
+        row.key = plan.key(&spec.name, "reference", REFERENCE_LABEL);
+        row.is_default = true;
+        rows::append(journal, &row)?;
+    }
+    // The allocator's total without any indirect method, to subtract.
+    let baseline = {
+        let _none = Renderer::new(gpu, scene, &settings_of(plan, Method::None))?;
+        allocated_bytes(gpu)
+    };
+    for c in todo {
+        let settings = c.settings(&plan.base);
+        let label = c.label(&plan.base);
+        let mut r = Renderer::new(gpu, scene, &settings)
+            .with_context(|| format!("{} {label} on {}", c.method.name(), spec.name))?;
+        let memory = match (allocated_bytes(gpu), baseline) {
+            (Some(a), Some(b)) => Some(a - b),
+            _ => None,
+        };
+        let mut stats = FrameStats::default();
+        let mut flicker = metrics::Flicker::default();
+        let mut flicker_final = metrics::Flicker::default();
+        let (mut e_ind, mut e_fin, mut e_flip) = (0.0, 0.0, 0.0);
+        let mut evals = None;
+        for k in 0..plan.frames {
+            bar.set_message(format!(
+                "{}: {} {label}, frame {}/{}",
+                spec.name,
+                c.method.name(),
+                k + 1,
+                plan.frames
+            ));
+            r.update(&scene.state_at(frame_time(spec, k)))?;
+            let n = if k == 0 { plan.timing_frames } else { 1 };
+            let s = r.render_frames(n, |_| {})?;
+            stats.frames.extend(s.frames);
+            let out = r.readback()?;
+            let reference = &refs[k as usize];
+            e_ind += metrics::relative_rmse(&out.indirect, &reference.indirect, &reference.mask);
+            e_fin += metrics::relative_rmse(
+                &out.final_radiance,
+                &reference.final_radiance,
+                &reference.mask,
+            );
+            let map = flip::flip_map(
+                &reference.display,
+                &out.display,
+                out.width,
+                out.height,
+                flip::PIXELS_PER_DEGREE,
+            );
+            e_flip += flip::mean_flip(&map, &reference.mask);
+            flicker.add(&out.indirect, &reference.indirect, &reference.mask);
+            flicker_final.add(
+                &out.final_radiance,
+                &reference.final_radiance,
+                &reference.mask,
+            );
+            if k + 1 == plan.frames {
+                evals = light_patch_evals(&r, &settings, &out)?;
+            }
+            if k == plan.frames / 2 && c.is_default(&plan.base) {
+                let name = c.method.name();
+                crate::output::write_png(
+                    &images.join(format!("{name}.png")),
+                    out.width,
+                    out.height,
+                    &out.display,
+                )?;
+                crate::output::write_png(
+                    &images.join(format!("{name}-error.png")),
+                    out.width,
+                    out.height,
+                    &charts::heat_map(&map),
+                )?;
+            }
+            bar.inc(1);
+        }
+        let f = plan.frames as f64;
+        let mut row = timing_row(plan, spec, &settings, &stats);
+        row.key = plan.key(&spec.name, c.method.name(), &label);
+        row.label = label;
+        row.is_default = c.is_default(&plan.base);
+        row.rel_rmse_indirect = e_ind / f;
+        row.rel_rmse_final = e_fin / f;
+        row.flip = e_flip / f;
+        row.flicker = flicker.flicker();
+        row.flicker_second = flicker.second_difference();
+        row.flicker_final = flicker_final.flicker();
+        row.light_patch_evals = evals;
+        row.gpu_memory_bytes = memory;
+        if bar.is_hidden() {
+            // No terminal (a log, CI): one line per finished row instead.
+            eprintln!(
+                "{}: {} {}: {:.1} ms indirect, relative RMSE {:.4}",
+                row.scene,
+                row.method,
+                row.label,
+                row.indirect_ms.unwrap_or(f64::NAN),
+                row.rel_rmse_indirect
+            );
+        }
+        rows::append(journal, &row)?;
+    }
+    Ok(())
+}
+
+fn settings_of(plan: &Plan, method: Method) -> RenderSettings {
+    RenderSettings {
+        method,
+        ..plan.base.clone()
+    }
+}
+
+/// Light-patch evaluations of the last frame: counted by the multiresolution
+/// gathers (and splats), or pixels with geometry times N for the
+/// full-resolution methods that evaluate every VPL at every pixel.
+fn light_patch_evals(r: &Renderer, s: &RenderSettings, out: &Readback) -> Result<Option<u64>> {
+    Ok(match s.method {
+        m if m.uses_multires() => r
+            .readback_multires()?
+            .map(|m| crate::debug_view::light_patch_stats(&m, None).total_evaluations)
+            .filter(|&n| n > 0),
+        Method::RsmGather | Method::RsmSplat => {
+            let pixels = out.position.iter().filter(|p| p[3] > 0.0).count() as u64;
+            Some(pixels * s.vpls as u64)
+        }
+        _ => None,
+    })
+}
+
+/// A row with the settings and the timings filled in; errors zero.
+fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameStats) -> Row {
+    let report = crate::report::build(
+        &crate::report::RunInfo {
+            device: "",
+            driver: "",
+            scene: &spec.name,
+            width: s.width,
+            height: s.height,
+            rsm: s.rsm_resolution,
+            method: s.method.name(),
+        },
+        stats,
+    );
+    let indirect_min = stats
+        .frames
+        .iter()
+        .filter_map(|f| {
+            f.iter()
+                .filter(|p| p.kind.indirect)
+                .map(|p| p.gpu_ms)
+                .try_fold(0.0, |a, ms| Some(a + ms?))
+        })
+        .reduce(f64::min);
+    let last = stats.frames.last();
+    let fragments = last.map(|f| {
+        f.iter()
+            .filter(|p| p.kind.indirect)
+            .filter_map(|p| p.fragment_invocations)
+            .sum::<u64>()
+    });
+    Row {
+        key: String::new(),
+        scene: spec.name.clone(),
+        method: s.method.name().into(),
+        label: String::new(),
+        is_default: false,
+        vpls: s
+            .method
+            .uses_regular_vpls()
+            .then_some(s.vpls)
+            .filter(|_| !matches!(s.method, Method::Isr | Method::Hisr)),
+        isr_base: (s.method == Method::Isr).then_some(s.light_tree.isr_base),
+        tau: (s.method == Method::Hisr).then_some(s.light_tree.tau),
+        max_depth: (s.method == Method::Hisr).then_some(s.hisr_max_depth()),
+        depth_threshold: s.multires.depth_threshold,
+        normal_threshold: s.multires.normal_threshold_deg,
+        width: s.width,
+        height: s.height,
+        rsm: s.rsm_resolution,
+        frames: plan.frames,
+        indirect_ms: report.indirect_gpu_ms_median,
+        indirect_ms_min: indirect_min,
+        total_ms: report.total_gpu_ms_median,
+        passes: report
+            .passes
+            .iter()
+            .filter_map(|p| Some((p.name.clone(), p.gpu_ms_median?)))
+            .collect(),
+        fragment_invocations: fragments,
+        light_patch_evals: None,
+        rel_rmse_indirect: 0.0,
+        rel_rmse_final: 0.0,
+        flip: 0.0,
+        flicker: None,
+        flicker_second: None,
+        flicker_final: None,
+        gpu_memory_bytes: None,
+    }
+}

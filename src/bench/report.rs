@@ -1,0 +1,301 @@
+//! What a bench run writes from its rows: `results.json`, `results.csv`, the
+//! charts, the gallery, and `report.md` with the ratios the issue asks for,
+//! computed from the same rows.
+
+use super::rows::{self, Row};
+use super::{Outcome, Plan};
+use anyhow::Result;
+use serde_json::json;
+
+/// One computed ratio (or error level) and how it came about.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Ratio {
+    pub scene: String,
+    pub measure: String,
+    pub value: Option<f64>,
+    pub detail: String,
+}
+
+const REGULAR: &[&str] = &[
+    "rsm-gather",
+    "rsm-splat",
+    "rsm-splat-restricted",
+    "multires-splat",
+    "multires-gather",
+];
+
+fn find<'a>(rows: &'a [Row], scene: &str, method: &str, vpls: u32) -> Option<&'a Row> {
+    rows.iter()
+        .find(|r| r.scene == scene && r.method == method && r.vpls == Some(vpls))
+}
+
+fn ms(r: &Row) -> f64 {
+    r.indirect_ms.unwrap_or(f64::NAN)
+}
+
+/// The fastest row of `method` in `scene` whose indirect error is at most `error`.
+fn fastest_at_most<'a>(rows: &'a [Row], scene: &str, method: &str, error: f64) -> Option<&'a Row> {
+    rows.iter()
+        .filter(|r| r.scene == scene && r.method == method && r.indirect_ms.is_some())
+        .filter(|r| r.rel_rmse_indirect <= error)
+        .min_by(|a, b| ms(a).total_cmp(&ms(b)))
+}
+
+/// The lowest-error row of `method` in `scene` no slower than `time` ms.
+fn best_within<'a>(rows: &'a [Row], scene: &str, method: &str, time: f64) -> Option<&'a Row> {
+    rows.iter()
+        .filter(|r| {
+            r.scene == scene && r.method == method && r.indirect_ms.is_some_and(|t| t <= time)
+        })
+        .min_by(|a, b| a.rel_rmse_indirect.total_cmp(&b.rel_rmse_indirect))
+}
+
+fn describe(r: &Row) -> String {
+    format!(
+        "{} {} ({:.1} ms, RMSE {:.3})",
+        r.method,
+        r.label,
+        ms(r),
+        r.rel_rmse_indirect
+    )
+}
+
+/// The ratios of the issue, per scene: HISR's indirect-time speedup over each
+/// regular method with 256 VPLs at equal or lower error, over multires-gather
+/// with 4096 at its error, the error HISR reaches in the time of 256 regular
+/// VPLs, and HISR's flicker against 256 and 4096 regular VPLs.
+pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
+    let mut scenes: Vec<&str> = vec![];
+    for r in rows {
+        if !scenes.contains(&r.scene.as_str()) {
+            scenes.push(&r.scene);
+        }
+    }
+    let mut out = vec![];
+    for s in scenes {
+        let mut push = |measure: String, value: Option<f64>, detail: String| {
+            out.push(Ratio {
+                scene: s.into(),
+                measure,
+                value,
+                detail,
+            })
+        };
+        for (base, n) in REGULAR
+            .iter()
+            .map(|b| (b, 256))
+            .chain([(&"multires-gather", 4096)])
+        {
+            let Some(b) = find(rows, s, base, n) else {
+                continue;
+            };
+            match fastest_at_most(rows, s, "hisr", b.rel_rmse_indirect) {
+                Some(h) => push(
+                    format!("speedup of hisr over {base} {n} at equal or lower error"),
+                    Some(ms(b) / ms(h)),
+                    format!("{} against {}", describe(h), describe(b)),
+                ),
+                None => push(
+                    format!("speedup of hisr over {base} {n} at equal or lower error"),
+                    None,
+                    format!("no hisr setting reaches RMSE {:.3}", b.rel_rmse_indirect),
+                ),
+            }
+        }
+        for base in ["multires-splat", "multires-gather"] {
+            let Some(b) = find(rows, s, base, 256) else {
+                continue;
+            };
+            let m = format!("hisr error in the time of {base} 256 (relative to its error)");
+            match best_within(rows, s, "hisr", ms(b)) {
+                Some(h) => push(
+                    m,
+                    Some(h.rel_rmse_indirect / b.rel_rmse_indirect),
+                    format!("{} against {}", describe(h), describe(b)),
+                ),
+                None => push(
+                    m,
+                    None,
+                    format!("every hisr setting is slower than {:.1} ms", ms(b)),
+                ),
+            }
+        }
+        let hisr = rows
+            .iter()
+            .find(|r| r.scene == s && r.method == "hisr" && r.is_default);
+        for n in [256, 4096] {
+            let (Some(h), Some(b)) = (hisr, find(rows, s, "multires-gather", n)) else {
+                continue;
+            };
+            if let (Some(fh), Some(fb)) = (h.flicker, b.flicker) {
+                push(
+                    format!("flicker of hisr (default) / multires-gather {n}"),
+                    Some(fh / fb),
+                    format!("{fh:.4} against {fb:.4}"),
+                );
+            }
+        }
+    }
+    out
+}
+
+fn fmt_value(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| format!("{v:.3}"))
+}
+
+/// The ratios as a plain-text table (printed by `isr bench` and `cargo bench`).
+pub fn ratios_text(ratios: &[Ratio]) -> String {
+    let mut out = String::new();
+    for r in ratios {
+        out += &format!(
+            "{:<14} {:<72} {:>8}  {}\n",
+            r.scene,
+            r.measure,
+            fmt_value(r.value),
+            r.detail
+        );
+    }
+    out
+}
+
+fn cell<T: std::fmt::Display>(v: Option<T>) -> String {
+    v.map_or("-".into(), |v| v.to_string())
+}
+
+/// `report.md`: run facts, charts, ratios and one table per scene.
+pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio]) -> String {
+    let b = &plan.base;
+    let mut md = format!(
+        "# isr bench\n\nDevice: **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
+(1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
+section 6.2), errors means over frames against the dense reference of the same frame (section 6.1), \
+flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (section 6.4).{}\n\n",
+        o.device,
+        o.driver,
+        b.width,
+        b.height,
+        b.rsm_resolution,
+        plan.frames,
+        plan.timing_frames,
+        if plan.quick { " Quick run (smoke test)." } else { "" }
+    );
+    md += "![speed against error](speed_vs_error.svg)\n\n![flicker](flicker.svg)\n\n\
+![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n## Ratios\n\n\
+| scene | measure | value | detail |\n| --- | --- | ---: | --- |\n";
+    for r in ratios {
+        md += &format!(
+            "| {} | {} | {} | {} |\n",
+            r.scene,
+            r.measure,
+            fmt_value(r.value),
+            r.detail
+        );
+    }
+    for s in &plan.scenes {
+        md += &format!(
+            "\n## {}\n\n| method | setting | indirect ms (min) | total ms | RMSE indirect | RMSE final | FLIP | flicker | light-patch evals | memory MiB |\n\
+| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
+            s.name
+        );
+        for r in o.rows.iter().filter(|r| r.scene == s.name) {
+            md += &format!(
+                "| {}{} | {} | {} ({}) | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} |\n",
+                r.method,
+                if r.is_default { " *" } else { "" },
+                r.label,
+                cell(r.indirect_ms.map(|v| format!("{v:.1}"))),
+                cell(r.indirect_ms_min.map(|v| format!("{v:.1}"))),
+                cell(r.total_ms.map(|v| format!("{v:.1}"))),
+                r.rel_rmse_indirect,
+                r.rel_rmse_final,
+                r.flip,
+                cell(r.flicker.map(|v| format!("{v:.4}"))),
+                cell(r.light_patch_evals),
+                cell(
+                    r.gpu_memory_bytes
+                        .map(|v| format!("{:.2}", v as f64 / 1048576.0))
+                ),
+            );
+        }
+    }
+    md += "\n`*`: the method's default setting (gallery, per-pass chart).\n";
+    md
+}
+
+/// Writes every output of a run into its folder.
+pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
+    let dir = &plan.out_dir;
+    let b = &plan.base;
+    let ratios = ratios(&o.rows);
+    let scenes: Vec<String> = plan.scenes.iter().map(|s| s.name.clone()).collect();
+    let json = json!({
+        "device": o.device,
+        "driver": o.driver,
+        "width": b.width,
+        "height": b.height,
+        "rsm": b.rsm_resolution,
+        "frames": plan.frames,
+        "timing_frames": plan.timing_frames,
+        "quick": plan.quick,
+        "scenes": scenes,
+        "ratios": ratios,
+        "rows": o.rows,
+    });
+    crate::output::write_text(
+        &dir.join("results.json"),
+        &serde_json::to_string_pretty(&json)?,
+    )?;
+    crate::output::write_text(&dir.join("results.csv"), &rows::to_csv(&o.rows))?;
+    super::charts::speed_vs_error(dir, &o.rows, &scenes)?;
+    super::charts::flicker(dir, &o.rows, &scenes)?;
+    super::charts::passes(dir, &o.rows, &scenes)?;
+    let methods: Vec<&str> = plan.methods.iter().map(|m| m.name()).collect();
+    super::charts::gallery(dir, &o.rows, &scenes, &methods)?;
+    crate::output::write_text(&dir.join("report.md"), &markdown(plan, o, &ratios))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(method: &str, vpls: Option<u32>, ms: f64, err: f64, flicker: f64) -> Row {
+        let mut r = super::super::rows::tests_support::row("k");
+        r.method = method.into();
+        r.vpls = vpls;
+        r.indirect_ms = Some(ms);
+        r.rel_rmse_indirect = err;
+        r.flicker = Some(flicker);
+        r.is_default = method == "hisr" && ms == 10.0;
+        r
+    }
+
+    #[test]
+    fn ratios_pick_the_fastest_hisr_at_equal_or_lower_error() {
+        let rows = vec![
+            row("multires-splat", Some(256), 100.0, 0.2, 0.04),
+            row("multires-gather", Some(256), 80.0, 0.2, 0.04),
+            row("multires-gather", Some(4096), 400.0, 0.08, 0.01),
+            row("hisr", None, 5.0, 0.3, 0.02),
+            row("hisr", None, 10.0, 0.15, 0.01),
+            row("hisr", None, 50.0, 0.07, 0.005),
+        ];
+        let r = ratios(&rows);
+        let get = |m: &str| r.iter().find(|x| x.measure.starts_with(m)).unwrap().value;
+        // 0.15 <= 0.2 at 10 ms: 100 / 10.
+        assert_eq!(get("speedup of hisr over multires-splat 256"), Some(10.0));
+        // 0.07 <= 0.08 at 50 ms: 400 / 50.
+        assert_eq!(get("speedup of hisr over multires-gather 4096"), Some(8.0));
+        // Within 100 ms the best HISR error is 0.07: 0.07 / 0.2.
+        let e = get("hisr error in the time of multires-splat 256").unwrap();
+        assert!((e - 0.35).abs() < 1e-12);
+        assert_eq!(
+            get("flicker of hisr (default) / multires-gather 256"),
+            Some(0.25)
+        );
+        assert_eq!(
+            get("flicker of hisr (default) / multires-gather 4096"),
+            Some(1.0)
+        );
+    }
+}
