@@ -61,7 +61,7 @@ fn main() -> anyhow::Result<()> {
         1,
     )?;
     let mut runs = Vec::new();
-    for n in [256u32; 0] {
+    for n in [256, 1024, 4096] {
         runs.push(run(
             &gpu,
             &format!("multires-gather {n}"),
@@ -75,7 +75,7 @@ fn main() -> anyhow::Result<()> {
         &with(Method::Isr, 256, Default::default()),
         3,
     )?);
-    for tau in [0.5, 0.2, 0.05, 0.01, 0.002] {
+    for tau in [0.5, 0.2, 0.05, 0.01] {
         let lt = LightTreeSettings {
             tau,
             ..Default::default()
