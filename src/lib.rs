@@ -22,4 +22,5 @@ pub mod report;
 pub mod scene;
 pub mod settings;
 pub mod view;
+pub mod viewer;
 pub mod vk;

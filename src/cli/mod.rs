@@ -12,6 +12,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 mod runs;
+mod view;
 use runs::*;
 
 #[derive(Parser)]
@@ -30,6 +31,10 @@ enum Command {
     /// Render a scene headless and write EXR, PNG and per-pass GPU timings.
     #[command(allow_negative_numbers = true)]
     Render(Box<RenderArgs>),
+    /// Show a scene in a window: fly the camera, move the light, switch
+    /// methods, per-pass GPU times on screen (keys: README, "Interactive").
+    #[command(allow_negative_numbers = true)]
+    View(Box<view::ViewArgs>),
     /// List the Vulkan devices (the index is what --device takes).
     Devices,
     /// Write the built-in Cornell box as a glTF file.
@@ -287,6 +292,7 @@ pub fn run() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Render(args) => render(*args),
+        Command::View(args) => view::view(*args),
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {
             let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;
