@@ -434,13 +434,14 @@ impl<'g> Renderer<'g> {
     }
 
     /// Waits until no frame is in flight (before reading results back or
-    /// changing what frames use).
-    pub fn wait_idle(&mut self) -> Result<()> {
+    /// changing what frames use); returns the per-pass numbers of the frames
+    /// that were.
+    pub fn wait_idle(&mut self) -> Result<Vec<Vec<PassSample>>> {
         let mut stats = FrameStats::default();
         for slot in 0..self.slots.len() {
             self.complete(slot, &mut stats)?;
         }
-        Ok(())
+        Ok(stats.frames)
     }
 
     /// Switches to `settings`, which may differ from the current ones only in
@@ -456,6 +457,7 @@ impl<'g> Renderer<'g> {
             bail!("set_method_settings cannot change the output size or the RSM resolution");
         }
         check_settings(self.gpu, settings)?;
+        // The frames in flight were of the old method; their numbers go.
         self.wait_idle()?;
         let gpu = self.gpu;
         let setup = Setup {

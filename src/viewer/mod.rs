@@ -452,8 +452,16 @@ impl<'g> Viewer<'g> {
         Ok(())
     }
 
+    /// Waits for the frames in flight, keeping their numbers for the overlay.
+    fn wait_idle(&mut self) -> Result<()> {
+        for samples in self.renderer.wait_idle()? {
+            self.stats.add(&samples);
+        }
+        Ok(())
+    }
+
     fn recreate_swapchain(&mut self) -> Result<()> {
-        self.renderer.wait_idle()?;
+        self.wait_idle()?;
         let size = self.window.inner_size();
         let old = self.swapchain.take();
         self.swapchain = Swapchain::new(
@@ -472,7 +480,8 @@ impl<'g> Viewer<'g> {
         Ok(())
     }
 
-    /// Runs the script's commands that are due.
+    /// Runs the script's commands that are due, up to and including the
+    /// first screenshot (so that it shows what the commands before it did).
     fn run_script(&mut self) {
         let Some(start) = self.first_presented else {
             return;
@@ -486,7 +495,11 @@ impl<'g> Viewer<'g> {
             self.next_command += 1;
             match command {
                 script::Command::Key(k) => self.press(k, true),
-                script::Command::Screenshot(p) => self.screenshot_to = Some(p),
+                script::Command::Screenshot(p) => {
+                    // The shot shows this frame: later commands wait for the next one.
+                    self.screenshot_to = Some(p);
+                    break;
+                }
                 script::Command::Resize(w, h) => {
                     let _ = self
                         .window
@@ -582,10 +595,10 @@ impl<'g> Viewer<'g> {
         if self.first_presented.is_none() {
             self.first_presented = Some(Instant::now());
         }
+        let (w, h) = (sc.extent.width, sc.extent.height);
         if screenshot {
-            self.renderer.wait_idle()?;
+            self.wait_idle()?;
             let path = self.screenshot_to.take().unwrap();
-            let (w, h) = (sc.extent.width, sc.extent.height);
             let rgba = self
                 .presenter
                 .screenshot_rgba()
@@ -597,7 +610,7 @@ impl<'g> Viewer<'g> {
             // Levels and vpl-count are made on the host from the frame's
             // multiresolution buffer, as `isr render --debug-view` makes them,
             // and shown from the next frame on (slow: a readback per frame).
-            self.renderer.wait_idle()?;
+            self.wait_idle()?;
             if let Some(m) = self.renderer.readback_multires()? {
                 let rgba = if self.shown == Shown::Levels {
                     crate::debug_view::levels_png(&m)

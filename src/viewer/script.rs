@@ -10,7 +10,8 @@
 //!
 //! Blank lines and text after `#` are ignored. Commands run in time order
 //! (lines with equal times in file order), each on the first frame at or
-//! after its time.
+//! after its time; a screenshot shows the commands before it applied, none
+//! after it.
 
 use super::controls::Key;
 use anyhow::{bail, Context as _, Result};
