@@ -326,17 +326,17 @@ impl<'g> Viewer<'g> {
         };
         let presenter =
             Presenter::new(gpu, renderer.frame_set_layout(), &renderer.targets, format)?;
-        let mut list = Vec::new();
+        // Made into their owner, which frees them if a later one fails.
+        let mut acquire = Semaphores {
+            list: Vec::new(),
+            shared: gpu.shared.clone(),
+        };
         for _ in 0..crate::renderer::FRAMES_IN_FLIGHT {
-            list.push(unsafe {
+            acquire.list.push(unsafe {
                 gpu.device
                     .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
             }?);
         }
-        let acquire = Semaphores {
-            list,
-            shared: gpu.shared.clone(),
-        };
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         let controls = Controls::new(&scene.state_at(options.time).camera, extent);
         Ok(Self {
