@@ -273,6 +273,23 @@ mod tests {
         assert_eq!(Key::from_code(KeyCode::Escape), Some(Key::Quit));
     }
 
+    /// The README's key table names every key (scripts use the same names).
+    #[test]
+    fn readme_lists_every_key() {
+        let readme = include_str!("../../README.md");
+        let table = readme
+            .split("## Interactive")
+            .nth(1)
+            .and_then(|s| s.split("\n## ").next())
+            .expect("README has an Interactive section");
+        for (_, _, name, _) in KEYS {
+            assert!(
+                table.contains(&format!("`{name}`")),
+                "README does not list `{name}`"
+            );
+        }
+    }
+
     #[test]
     fn camera_round_trips_and_moves() {
         let cam = Camera::look_at(
