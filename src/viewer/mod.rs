@@ -7,6 +7,7 @@
 //! shown (`controls`); `--script` plays timed input (`script`).
 
 pub mod controls;
+pub mod overlay;
 pub mod present;
 pub mod script;
 
@@ -14,12 +15,12 @@ use crate::gpu_types::{PRESENT_VIEW_FINAL, PRESENT_VIEW_HOST, PRESENT_VIEW_INDIR
 use crate::renderer::Renderer;
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
-use crate::vk::profiler::PassSample;
-use crate::vk::swapchain::{Surface, Swapchain};
+use crate::vk::swapchain::{Semaphores, Surface, Swapchain};
 use crate::vk::{Gpu, GpuOptions};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use controls::{Controls, Key};
+use overlay::PassAverages;
 use present::{PresentFrame, Presenter, COLUMNS, ROWS};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use std::path::PathBuf;
@@ -218,47 +219,6 @@ impl ApplicationHandler for App<'_> {
     }
 }
 
-/// Per-pass numbers averaged over the frames since the overlay's last update.
-#[derive(Default)]
-struct PassAverages {
-    frames: u32,
-    passes: Vec<(&'static str, bool, f64, u32)>,
-    started: Option<Instant>,
-}
-
-impl PassAverages {
-    fn add(&mut self, samples: &[PassSample]) {
-        self.frames += 1;
-        for s in samples {
-            let Some(ms) = s.gpu_ms else { continue };
-            match self.passes.iter_mut().find(|p| p.0 == s.name) {
-                Some(p) => {
-                    p.2 += ms;
-                    p.3 += 1;
-                }
-                None => self.passes.push((s.name, s.kind.indirect, ms, 1)),
-            }
-        }
-    }
-}
-
-/// Acquire semaphores, one per frame in flight, freed when dropped.
-struct Semaphores {
-    list: Vec<vk::Semaphore>,
-    shared: Arc<crate::vk::context::Shared>,
-}
-
-impl Drop for Semaphores {
-    fn drop(&mut self) {
-        unsafe {
-            let _ = self.shared.device.device_wait_idle();
-            for &s in &self.list {
-                self.shared.device.destroy_semaphore(s, None);
-            }
-        }
-    }
-}
-
 struct Viewer<'g> {
     // Dropped in this order: swapchain, what frames use, renderer, surface, window.
     swapchain: Option<Swapchain>,
@@ -326,17 +286,7 @@ impl<'g> Viewer<'g> {
         };
         let presenter =
             Presenter::new(gpu, renderer.frame_set_layout(), &renderer.targets, format)?;
-        // Made into their owner, which frees them if a later one fails.
-        let mut acquire = Semaphores {
-            list: Vec::new(),
-            shared: gpu.shared.clone(),
-        };
-        for _ in 0..crate::renderer::FRAMES_IN_FLIGHT {
-            acquire.list.push(unsafe {
-                gpu.device
-                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
-            }?);
-        }
+        let acquire = Semaphores::new(gpu, crate::renderer::FRAMES_IN_FLIGHT)?;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         let controls = Controls::new(&scene.state_at(options.time).camera, extent);
         Ok(Self {
@@ -632,71 +582,14 @@ impl<'g> Viewer<'g> {
         {
             return;
         }
-        let since = self.stats.started.unwrap_or(now);
-        let elapsed = (now - since).as_secs_f64();
-        let fps = if elapsed > 0.0 {
-            self.stats.frames as f64 / elapsed
-        } else {
-            0.0
-        };
-        let s = &self.renderer.settings;
-        let mut lines: Vec<(u32, String)> = vec![
-            (
-                1,
-                format!(
-                    "isr view  {}  {}x{}  rsm {}",
-                    s.method.name(),
-                    s.width,
-                    s.height,
-                    s.rsm_resolution
-                ),
-            ),
-            (
-                0,
-                format!(
-                    "vpls {}  tau {}  view {}",
-                    s.effective_vpls(),
-                    s.light_tree.tau,
-                    self.shown.name()
-                ),
-            ),
-        ];
-        let mut total = 0.0;
-        let mut indirect = 0.0;
-        let mut pass_lines = Vec::new();
-        for &(name, is_indirect, sum, n) in &self.stats.passes {
-            let ms = sum / n.max(1) as f64;
-            total += ms;
-            if is_indirect {
-                indirect += ms;
-            }
-            pass_lines.push((
-                if is_indirect { 3 } else { 0 },
-                format!("{name:<22}{ms:>9.2} ms"),
-            ));
-        }
-        lines.push((
-            1,
-            format!("fps {fps:.1}  gpu {total:.1} ms  indirect {indirect:.1} ms"),
-        ));
-        lines.extend(pass_lines);
-        lines.push((
-            2,
-            format!(
-                "t {:.2} s{}",
-                self.time,
-                if self.paused { " (paused)" } else { "" }
-            ),
-        ));
-        lines.push((2, self.status.clone()));
-        lines.push((2, "M method  [ ] tau  , . vpls  V view  P pause".into()));
-        self.cells.fill(0);
-        for (row, (colour, text)) in lines.iter().take(ROWS).enumerate() {
-            for (col, ch) in text.chars().take(COLUMNS).enumerate() {
-                let c = if ch.is_ascii() { ch as u32 } else { '?' as u32 };
-                self.cells[row * COLUMNS + col] = c | colour << 8;
-            }
-        }
+        self.cells = overlay::cells(&overlay::Shown {
+            settings: &self.renderer.settings,
+            view: self.shown.name(),
+            stats: &self.stats,
+            time: self.time,
+            paused: self.paused,
+            status: &self.status,
+        });
         self.stats = PassAverages {
             started: Some(now),
             ..Default::default()

@@ -223,3 +223,39 @@ impl Drop for Swapchain {
         }
     }
 }
+
+/// Binary semaphores (a swapchain image's acquisition, one per frame in
+/// flight), freed when dropped.
+pub struct Semaphores {
+    pub list: Vec<vk::Semaphore>,
+    shared: Arc<Shared>,
+}
+
+impl Semaphores {
+    pub fn new(gpu: &Gpu, n: usize) -> Result<Self> {
+        // Made into their owner, which frees them if a later one fails.
+        let mut out = Self {
+            list: Vec::new(),
+            shared: gpu.shared.clone(),
+        };
+        for _ in 0..n {
+            let s = unsafe {
+                gpu.device
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            }?;
+            out.list.push(s);
+        }
+        Ok(out)
+    }
+}
+
+impl Drop for Semaphores {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.shared.device.device_wait_idle();
+            for &s in &self.list {
+                self.shared.device.destroy_semaphore(s, None);
+            }
+        }
+    }
+}
