@@ -91,4 +91,27 @@ struct DrawPush {
     uint material;  // index into the materials
 };
 
+// Push constants of the viewer's present pass (present.frag): the frame's
+// image scaled into the window, aspect kept, the rest letterboxed.
+struct PresentPush {
+    ivec4 rect;        // xy: the image's top-left corner in the window (pixels); zw: its size
+    vec4 letterbox;    // rgb: colour outside the image, display-encoded
+    int view;          // PRESENT_VIEW_*: what is shown
+    int srgb_target;   // 1: the window's format encodes sRGB itself (write linear values)
+    int pad0;
+    int pad1;
+};
+
+// PresentPush.view.
+const int PRESENT_VIEW_FINAL = 0;     // the tonemapped frame (the PNG of `isr render`)
+const int PRESENT_VIEW_INDIRECT = 1;  // albedo / pi * E alone, times the exposure
+const int PRESENT_VIEW_HOST = 2;      // an sRGB image the host uploaded (levels, vpl-count)
+
+// Push constants of the viewer's text overlay (overlay_text.vert/.frag): a
+// grid of 8x8 glyphs; each cell of the text buffer is `char | colour << 8`.
+struct OverlayPush {
+    ivec4 rect;    // xy: the grid's top-left corner (pixels); z, w: columns, rows
+    ivec4 target;  // x, y: window size (pixels); z: screen pixels per glyph pixel; w: unused
+};
+
 #endif

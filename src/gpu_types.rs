@@ -118,3 +118,28 @@ pub struct DrawPush {
     pub instance: u32,
     pub material: u32,
 }
+
+/// `PresentPush`: push constants of the viewer's present pass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PresentPush {
+    pub rect: [i32; 4],
+    pub letterbox: [f32; 4],
+    pub view: i32,
+    pub srgb_target: i32,
+    pub pad0: i32,
+    pub pad1: i32,
+}
+
+/// `PresentPush.view` values, as in `shaders/shared.glsl`.
+pub const PRESENT_VIEW_FINAL: i32 = 0;
+pub const PRESENT_VIEW_INDIRECT: i32 = 1;
+pub const PRESENT_VIEW_HOST: i32 = 2;
+
+/// `OverlayPush`: push constants of the viewer's text overlay.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct OverlayPush {
+    pub rect: [i32; 4],
+    pub target: [i32; 4],
+}

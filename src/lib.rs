@@ -24,4 +24,5 @@ pub mod scene;
 pub mod settings;
 pub mod soak;
 pub mod view;
+pub mod viewer;
 pub mod vk;

@@ -158,6 +158,25 @@ fn draw_push_matches_shared_glsl() {
     ]);
 }
 
+#[test]
+fn viewer_pushes_match_shared_glsl() {
+    use isr::gpu_types::{OverlayPush, PresentPush};
+    check!("present.frag", PresentPush, "PresentPush", pad1: 4, [
+        rect => "rect",
+        letterbox => "letterbox",
+        view => "view",
+        srgb_target => "srgb_target",
+        pad0 => "pad0",
+        pad1 => "pad1",
+    ]);
+    for shader in ["overlay_text.vert", "overlay_text.frag"] {
+        check!(shader, OverlayPush, "OverlayPush", target: 16, [
+            rect => "rect",
+            target => "target",
+        ]);
+    }
+}
+
 /// The flag constants are written twice (GLSL and Rust); read GLSL's.
 #[test]
 fn flag_constants_match_shared_glsl() {
@@ -186,6 +205,9 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("GEO_HAS_GEOMETRY"), GEO_HAS_GEOMETRY);
     assert_eq!(value("GEO_SMOOTH"), GEO_SMOOTH);
     assert_eq!(value("GEO_SPLIT"), GEO_SPLIT);
+    assert_eq!(value("PRESENT_VIEW_FINAL"), PRESENT_VIEW_FINAL as u32);
+    assert_eq!(value("PRESENT_VIEW_INDIRECT"), PRESENT_VIEW_INDIRECT as u32);
+    assert_eq!(value("PRESENT_VIEW_HOST"), PRESENT_VIEW_HOST as u32);
     let float = |name: &str| -> f32 {
         let line = glsl
             .lines()

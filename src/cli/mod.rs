@@ -13,6 +13,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 mod runs;
+mod view;
 use runs::*;
 
 #[derive(Parser)]
@@ -34,6 +35,10 @@ enum Command {
     /// Every method over its parameter sweep on the stress scenes, against
     /// the dense reference: results.json/.csv, charts, gallery, report.md.
     Bench(Box<crate::bench::BenchArgs>),
+    /// Show a scene in a window: fly the camera, move the light, switch
+    /// methods, per-pass GPU times on screen (keys: README, "Interactive").
+    #[command(allow_negative_numbers = true)]
+    View(Box<view::ViewArgs>),
     /// List the Vulkan devices (the index is what --device takes).
     Devices,
     /// Write the built-in Cornell box as a glTF file.
@@ -312,6 +317,7 @@ pub fn run() -> Result<()> {
     match cli.command {
         Command::Render(args) => render(*args),
         Command::Bench(args) => crate::bench::cli(&args),
+        Command::View(args) => view::view(*args),
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {
             let json = scene::export::to_gltf_json(&scene::cornell::cornell_box())?;

@@ -7,6 +7,7 @@ pub mod pipeline;
 pub mod profiler;
 pub mod reflect;
 pub mod resources;
+pub mod swapchain;
 
 pub use context::{Gpu, GpuOptions, Validation};
 pub use resources::{Buffer, Image, ImageDesc, Sampler};

@@ -195,6 +195,15 @@ fn layer_installed(entry: &ash::Entry) -> bool {
 }
 
 fn create_instance(entry: &ash::Entry, validate: bool) -> Result<ash::Instance> {
+    create_instance_with(entry, validate, &[])
+}
+
+/// An instance with the `required` extensions besides the debug ones.
+fn create_instance_with(
+    entry: &ash::Entry,
+    validate: bool,
+    required: &[*const std::ffi::c_char],
+) -> Result<ash::Instance> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"isr")
         .api_version(vk::API_VERSION_1_3);
@@ -204,7 +213,7 @@ fn create_instance(entry: &ash::Entry, validate: bool) -> Result<ash::Instance> 
         .filter_map(|e| e.extension_name_as_c_str().ok())
         .map(|s| s.to_string_lossy().into_owned())
         .collect();
-    let mut extensions = Vec::new();
+    let mut extensions = required.to_vec();
     if validate || available.iter().any(|e| e == "VK_EXT_debug_utils") {
         extensions.push(ash::ext::debug_utils::NAME.as_ptr());
     }
@@ -233,6 +242,16 @@ fn create_instance(entry: &ash::Entry, validate: bool) -> Result<ash::Instance> 
 
 impl Gpu {
     pub fn new(options: &GpuOptions) -> Result<Self> {
+        Self::with_extensions(options, &[], &[])
+    }
+
+    /// As `new`, with extra instance and device extensions (the viewer's
+    /// surface and swapchain; headless runs need none).
+    pub fn with_extensions(
+        options: &GpuOptions,
+        instance_extensions: &[*const std::ffi::c_char],
+        device_extensions: &[*const std::ffi::c_char],
+    ) -> Result<Self> {
         let injected_fault = fault::InjectedFault::from_env()?;
         let entry = load_entry()?;
         let validate = match options.validation {
@@ -248,7 +267,7 @@ impl Gpu {
                 true
             }
         };
-        let instance = create_instance(&entry, validate)?;
+        let instance = create_instance_with(&entry, validate, instance_extensions)?;
         // From here on, failures must destroy the messenger and the instance (in
         // that order, before the log the messenger writes to); a guard does it.
         let mut guard = InstanceGuard {
@@ -355,6 +374,7 @@ impl Gpu {
             .queue_priorities(&priorities)];
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
+            .enabled_extension_names(device_extensions)
             .enabled_features(&enabled)
             .push_next(&mut f13)
             .push_next(&mut f12);
@@ -484,8 +504,39 @@ impl Gpu {
 
     /// Submits `cmd`; `fence` (unsignalled) is signalled when it finishes.
     pub fn submit(&self, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<()> {
+        self.submit_with_semaphores(cmd, fence, None, None)
+    }
+
+    /// Submits `cmd` waiting on `wait` (at its stages) and signalling
+    /// `signal` when done, besides `fence` (presentation).
+    pub fn submit_with_semaphores(
+        &self,
+        cmd: vk::CommandBuffer,
+        fence: vk::Fence,
+        wait: Option<(vk::Semaphore, vk::PipelineStageFlags2)>,
+        signal: Option<vk::Semaphore>,
+    ) -> Result<()> {
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        let waits: Vec<_> = wait
+            .iter()
+            .map(|&(s, stage)| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(stage)
+            })
+            .collect();
+        let signals: Vec<_> = signal
+            .iter()
+            .map(|&s| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+            })
+            .collect();
+        let submit = [vk::SubmitInfo2::default()
+            .command_buffer_infos(&cmds)
+            .wait_semaphore_infos(&waits)
+            .signal_semaphore_infos(&signals)];
         if let Some(e) = self.injected_fault.as_ref().and_then(|f| f.on_submit()) {
             return Err(submit_error(e));
         }
