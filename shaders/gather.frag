@@ -11,7 +11,7 @@
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
-#include "lighting.glsl"
+#include "light_types.glsl"
 #include "multires.glsl"
 #include "vpl.glsl"
 
@@ -76,7 +76,8 @@ void chosen_list(vec3 xi, vec3 ni) {
 // (3 tau R^2)). The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
 // R^2 / 4^k and its threshold 4^k T. Invalid patches (spanning a
-// discontinuity) are always subdivided.
+// discontinuity) are always subdivided. For cube faces and orthographic RSMs
+// the right-hand side differs: hisr_bound in light_types.glsl derives it.
 //
 // Depth-first with a fixed stack and no recursion; children are pushed only
 // above the max depth and when they fit, so every fetch is inside the quadtree
@@ -88,7 +89,6 @@ void traverse(vec3 xi, vec3 ni) {
     int start = run.light_levels.x;
     int max_depth = run.light_levels.y;
     float t_finest = run.light_tree.x;
-    vec3 light = u.light_position.xyz;
     ivec3 stack[STACK_SIZE];  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     int side = 1 << start;
     for (int s = 0; s < side * side; ++s) {
@@ -103,8 +103,7 @@ void traverse(vec3 xi, vec3 ni) {
             bool split = false;
             if (node.z < max_depth && sp + 4 <= STACK_SIZE) {
                 vec3 vij = pos.xyz - xi;
-                vec3 vj = pos.xyz - light;
-                split = nrm.w == PATCH_INVALID || dot(vij, vij) <= exp2(float(2 * mip)) * t_finest * dot(vj, vj);
+                split = nrm.w == PATCH_INVALID || dot(vij, vij) <= exp2(float(2 * mip)) * hisr_bound(pos.xyz, node, t_finest);
             }
             if (split) {
                 for (int i = 3; i >= 0; --i) stack[sp++] = ivec3(2 * node.xy + ivec2(i & 1, i >> 1), node.z + 1);

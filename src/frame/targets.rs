@@ -47,6 +47,9 @@ const DEPTH_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
 /// RSM images carry the RSM quadtree in their mip chain (level 0 = the RSM).
 const RSM_USAGE: vk::ImageUsageFlags =
     vk::ImageUsageFlags::from_raw(COLOR_USAGE.as_raw() | vk::ImageUsageFlags::STORAGE.as_raw());
+/// `light-sum` adds light views' direct images in a compute shader.
+const DIRECT_USAGE: vk::ImageUsageFlags =
+    vk::ImageUsageFlags::from_raw(COLOR_USAGE.as_raw() | vk::ImageUsageFlags::STORAGE.as_raw());
 /// Methods clear, blend into, or write `indirect` from compute.
 const INDIRECT_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
     COLOR_USAGE.as_raw()
@@ -80,7 +83,7 @@ pub fn target_list() -> [TargetDesc; 12] {
         t("gbuffer_normal", GBUFFER_FORMATS[1], false, COLOR_USAGE),
         t("gbuffer_albedo", GBUFFER_FORMATS[2], false, COLOR_USAGE),
         t("gbuffer_depth", DEPTH_FORMAT, false, DEPTH_USAGE),
-        t("direct", HDR_FORMAT, false, COLOR_USAGE),
+        t("direct", HDR_FORMAT, false, DIRECT_USAGE),
         t("indirect", HDR_FORMAT, false, INDIRECT_USAGE),
         t("final", HDR_FORMAT, false, COLOR_USAGE),
         t("display", DISPLAY_FORMAT, false, COLOR_USAGE),

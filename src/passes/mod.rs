@@ -20,6 +20,7 @@
 pub mod composite;
 pub mod direct_light;
 pub mod gbuffer;
+pub mod light_sum;
 pub mod rsm;
 pub mod rsm_tree;
 pub mod tonemap;
