@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Direct light of one light view (docs/algorithm.md sections 2 and 7):
+// Direct light of one light view (docs/algorithm.md sections 2.3 and 2.4):
 //   L_direct = rho/pi * I(w) * max(0, n.l) / r^2 * V   (spot; point, this cube face's points)
 //   L_direct = rho/pi * E * max(0, n.l) * V            (directional)
 // with V from the RSM depth: 3x3 taps of hardware 2x2 PCF. Several views add up

@@ -1,6 +1,6 @@
 #version 460
 // Sums the direct and indirect images over a frame's light views (spot, each
-// cube face of a point light, directional; docs/algorithm.md section 7): every
+// cube face of a point light, directional; docs/algorithm.md section 2.4): every
 // view's passes write `direct` and `indirect` as if it were the only light, and
 // this pass adds them up in two images of its own. mode 0 (first view):
 // sum = this view; 1: sum += this view; 2 (last view): this view += sum, so

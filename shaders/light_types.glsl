@@ -1,4 +1,4 @@
-// What differs between the light types (docs/algorithm.md section 7): spot,
+// What differs between the light types (docs/algorithm.md section 2.4): spot,
 // one cube face of a point light, directional. Every pass that depends on the
 // type calls these small functions, so a pass's own code (and the HISR
 // traversal loop) stays the same for all types. Needs frame.glsl (`u`, `run`).
@@ -46,7 +46,7 @@ vec3 light_direction_from(vec3 p, out float r2) {
     return to_light * inversesqrt(r2);
 }
 
-// One RSM texel (docs/algorithm.md sections 2 and 7) at framebuffer
+// One RSM texel (docs/algorithm.md sections 2.3 and 2.4) at framebuffer
 // coordinate frag seeing point x with normal n (cos_j floored at min_cos):
 //   Phi_j = rho_j * intensity * measure; area: A_j (m^2); dw: dw_j (sr).
 // Perspective (spot, cube face): dw_j = texel^2 cos^3 alpha on the unit image
@@ -112,7 +112,7 @@ float validity_reach(vec3 p) {
     return distance(p, u.light_position.xyz);
 }
 
-// HISR (gather.frag, docs/algorithm.md sections 4 and 7): subdivide patch j
+// HISR (gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
 // (mean position pj, node xy at depth d: 2^d x 2^d patches across the RSM)
 // iff |V_ij|^2 <= 4^k * hisr_bound(...), k its levels above the finest.
 // t_finest = 2 (1 - tau) / (3 tau R^2) = dw_talk (1 - tau) / (pi tau) with

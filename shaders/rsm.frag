@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Reflective shadow map (docs/algorithm.md sections 2 and 7). Texel j holds the point
+// Reflective shadow map (docs/algorithm.md sections 2.3 and 2.4). Texel j holds the point
 // x_j it sees, its normal n_j, the VPL flux Phi_j = rho_j * I(w_j) * dw_j and world
 // area A_j = dw_j * r_j^2 / cos_j (spot, cube face), or Phi_j = rho_j E a and
 // A_j = a / cos_j (directional, texel area a); see light_types.glsl. Depth goes

@@ -23,7 +23,7 @@ struct FrameUniforms {
                             // z: index of the light in the scene; w: unused
 };
 
-// light_kind.x: what this frame set's RSM is rendered from (docs/algorithm.md section 7).
+// light_kind.x: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
 const int LIGHT_SPOT = 0;         // perspective, the square around the outer cone
 const int LIGHT_POINT = 1;        // one 90 degree cube face; six make the point light
 const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds

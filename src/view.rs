@@ -46,7 +46,7 @@ pub fn cube_face_axis(f: usize) -> Vec3 {
 }
 
 /// One RSM a frame renders: a spot light, one cube face of a point light, or
-/// a directional light (docs/algorithm.md section 7). Each has its own frame
+/// a directional light (docs/algorithm.md section 2.4). Each has its own frame
 /// set, RSM pass, light tree and indirect passes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightView {
@@ -131,7 +131,7 @@ pub fn light_views(
 /// The orthographic RSM of a directional light: a square perpendicular to
 /// the light around the bounds' projection, its centre snapped to whole
 /// texels in a frame fixed to the light's direction, so that the texel grid
-/// stays put on the scene while the camera moves (docs/algorithm.md section 7).
+/// stays put on the scene while the camera moves (docs/algorithm.md section 2.4).
 fn directional_view(index: usize, light: &Light, (lo, hi): (Vec3, Vec3), r: u32) -> LightView {
     let d = light.direction.normalize();
     let up = if d.dot(Vec3::Y).abs() > 0.99 {

@@ -1,5 +1,5 @@
 //! Point and directional lights, and several lights at once
-//! (docs/algorithm.md section 7): direct light against the formulas, shadows,
+//! (docs/algorithm.md section 2.4): direct light against the formulas, shadows,
 //! RSM energy, sums of lights, HISR convergence.
 mod common;
 

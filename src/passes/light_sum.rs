@@ -1,5 +1,5 @@
 //! Pass `light-sum`: adds up the direct and indirect images of a frame's
-//! light views (docs/algorithm.md section 7), `shaders/light_sum.comp`. Every
+//! light views (docs/algorithm.md section 2.4), `shaders/light_sum.comp`. Every
 //! view (a spot or directional light, or one cube face of a point light)
 //! records its RSM, direct, light-tree and method passes as if it were the
 //! only light; after each, this pass folds `direct` and `indirect` into its

@@ -82,7 +82,7 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
-/// What kind of `KHR_lights_punctual` light (docs/algorithm.md section 7).
+/// What kind of `KHR_lights_punctual` light (docs/algorithm.md section 2.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LightKind {
     /// A cone: intensity in candela (W/sr), the cones below apply.
@@ -106,7 +106,7 @@ impl LightKind {
     }
 }
 
-/// A `KHR_lights_punctual` light (docs/algorithm.md sections 2 and 7).
+/// A `KHR_lights_punctual` light (docs/algorithm.md sections 2.3 and 2.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
     pub kind: LightKind,
@@ -164,7 +164,7 @@ impl Light {
 
     /// Irradiance (W/m^2, per channel) on a surface at `p` facing the light,
     /// unshadowed: `I(w) / d^2` for spot and point lights, `E` for directional
-    /// ones (docs/algorithm.md section 7).
+    /// ones (docs/algorithm.md section 2.4).
     pub fn irradiance_facing(&self, p: glam::DVec3) -> glam::DVec3 {
         match self.kind {
             LightKind::Directional => self.color.as_dvec3() * self.intensity as f64,
