@@ -443,3 +443,107 @@ fn too_many_light_views_are_refused_before_allocating() {
     };
     assert!(e.contains("11 lights") && e.contains("66 RSMs"), "{e}");
 }
+
+#[test]
+fn lights_export_load_and_animate_with_their_own_nodes() {
+    // The built-in sweep moves light 0; a point light and a sun join it.
+    let mut scene = cornell_box();
+    scene.lights.push(box_point());
+    scene.lights.push(box_sun());
+    let json = isr::scene::export::to_gltf_json(&scene).unwrap();
+    let dir = std::env::temp_dir().join(format!("isr-lights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lights.gltf");
+    std::fs::write(&path, json).unwrap();
+    let loaded = isr::scene::gltf_load::load(&path).unwrap();
+    let kinds: Vec<_> = loaded.lights.iter().map(|l| l.kind).collect();
+    assert_eq!(
+        kinds,
+        [LightKind::Spot, LightKind::Point, LightKind::Directional]
+    );
+    for (a, b) in loaded.lights.iter().zip(&scene.lights) {
+        assert!(a.position.abs_diff_eq(b.position, 1e-5), "{a:?} vs {b:?}");
+        assert!(a.direction.abs_diff_eq(b.direction, 1e-5), "{a:?} vs {b:?}");
+        assert_eq!((a.intensity, a.color), (b.intensity, b.color));
+    }
+    let rest = loaded.state_at(0.0);
+    let later = loaded.state_at(1.0);
+    assert!(
+        later.lights[0].direction.x > 0.5,
+        "the spot sweeps: {:?}",
+        later.lights[0]
+    );
+    assert_eq!(later.lights[1..], rest.lights[1..], "the others stay");
+}
+
+#[test]
+fn isr_merges_a_flat_floor_under_cube_faces_and_orthographic_rsms() {
+    // On one plane every patch is valid (docs/algorithm.md section 2.5), so
+    // Basic ISR merges up to the root: one patch per RSM. A step in the floor
+    // (a raised square) makes the patches over its edges invalid.
+    let gpu = gpu();
+    let settings = RenderSettings {
+        method: Method::Isr,
+        light_tree: LightTreeSettings {
+            isr_base: 16,
+            ..Default::default()
+        },
+        ..direct_only(32, 64)
+    };
+    for light in [
+        point(Vec3::new(0.3, 1.2, -0.2), 7.0),
+        sun(Vec3::new(0.3, -1.0, 0.2), 2.0),
+    ] {
+        for step in [false, true] {
+            let mut scene = floor_scene(light, looking_down(), 1.0, 0.5);
+            if step {
+                let m = scene.add_material("step", Vec3::splat(0.5));
+                let h = 0.5;
+                scene.add_quad(
+                    "step",
+                    [
+                        Vec3::new(-h, 0.3, h),
+                        Vec3::new(h, 0.3, h),
+                        Vec3::new(h, 0.3, -h),
+                        Vec3::new(-h, 0.3, -h),
+                    ],
+                    m,
+                );
+            }
+            let mut r = Renderer::new(&gpu, &scene, &settings).unwrap();
+            // The point light's -y face sees the whole floor.
+            let view = if light.kind == LightKind::Point { 3 } else { 0 };
+            if light.kind == LightKind::Point {
+                assert_eq!(r.light_views()[view].direction, -Vec3::Y);
+            }
+            r.set_only_view(Some(view)).unwrap();
+            r.render_frames(1, |_| {}).unwrap();
+            let chosen = r.isr_chosen().unwrap().unwrap();
+            let rsm = r.readback().unwrap().rsm;
+            drop(r);
+            let flux: f64 = rsm.flux.iter().map(|t| t[0] as f64).sum();
+            let chosen_flux: f64 = chosen.iter().map(|p| p.flux[0] as f64).sum();
+            assert!(
+                ((flux - chosen_flux) / flux).abs() < 1e-4,
+                "chosen patches carry the RSM's flux"
+            );
+            println!("{:?}, step {step}: {} patches", light.kind, chosen.len());
+            if step {
+                assert!(
+                    chosen.len() > 16,
+                    "{:?}: the step's edges must stay unmerged: {}",
+                    light.kind,
+                    chosen.len()
+                );
+            } else {
+                assert_eq!(
+                    chosen.len(),
+                    1,
+                    "{:?}: one plane merges into one patch",
+                    light.kind
+                );
+            }
+        }
+    }
+    assert_validation_clean(&gpu);
+}
