@@ -51,7 +51,7 @@ void main() {
     float r2;
     vec3 l = light_direction_from(p, r2);
     float cos_i = max(dot(n, l), 0.0);
-    vec3 radiance = albedo / PI * light_intensity_toward(p) * cos_i / r2;
+    vec3 radiance = albedo / PI * light_intensity_toward(p, u.light_kind.y) * cos_i / r2;
     if (cos_i > 0.0) radiance *= visibility(p, n, cos_i);
     out_radiance = vec4(radiance, 1.0);
 }

@@ -11,21 +11,21 @@ bool light_is_directional() { return u.light_kind.x == LIGHT_DIRECTIONAL; }
 // Whether world point p belongs to this view's cube face: the face whose axis
 // is the largest component of p - light (ties go to x, then y, then z), so the
 // six faces partition the directions and no point is lit twice.
-bool in_cube_face(vec3 p) {
+bool in_cube_face(vec3 p, int face) {
     vec3 d = p - u.light_position.xyz;
     vec3 a = abs(d);
     int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
-    int face = u.light_kind.y;
-    return axis == face / 2 && d[axis] * u.light_direction[axis] > 0.0;
+    float sign = (face & 1) == 0 ? 1.0 : -1.0;
+    return axis == face / 2 && d[axis] * sign > 0.0;
 }
 
 // Spot and point: radiant intensity toward p (W/sr, per channel), zero outside
-// the spot's cone or this view's cube face. Directional: the irradiance E
-// (W/m^2) on a surface facing the light.
-vec3 light_intensity_toward(vec3 p) {
+// the spot's cone or cube face `face` (the RSM's layer, or this view's face).
+// Directional: the irradiance E (W/m^2) on a surface facing the light.
+vec3 light_intensity_toward(vec3 p, int face) {
     if (u.light_kind.x == LIGHT_SPOT) return spot_intensity(u, p);
     if (light_is_directional()) return u.light_intensity.rgb;
-    if (!in_cube_face(p)) return vec3(0.0);
+    if (!in_cube_face(p, face)) return vec3(0.0);
     vec3 i = u.light_intensity.rgb;
     if (u.light_position.w > 0.0) {
         float r = length(p - u.light_position.xyz) / u.light_position.w;
@@ -53,12 +53,12 @@ vec3 light_direction_from(vec3 p, out float r2) {
 // plane, Phi_j = rho I(w) dw_j, A_j = dw_j r^2 / cos_j. Orthographic: every
 // texel has the same area a = texel^2 perpendicular to the light,
 // Phi_j = rho E a, A_j = a / cos_j, and no solid angle (dw_j = 0).
-void rsm_texel(vec3 x, vec2 frag, vec3 n, float min_cos, out vec3 intensity, out float measure,
-               out float area, out float dw) {
+void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 intensity,
+               out float measure, out float area, out float dw) {
     float res = float(run.size.z);
     float half_extent = u.light_cone.z;
     float texel = 2.0 * half_extent / res;
-    intensity = light_intensity_toward(x);
+    intensity = light_intensity_toward(x, face);
     bool lit = max(intensity.r, max(intensity.g, intensity.b)) > 0.0;
     if (light_is_directional()) {
         float a = texel * texel;

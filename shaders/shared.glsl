@@ -21,6 +21,8 @@ struct FrameUniforms {
                             // depth range (m, directional)
     ivec4 light_kind;       // x: LIGHT_*; y: cube face of a point light (0..5: +x, -x, +y, -y, +z, -z);
                             // z: index of the light in the scene; w: unused
+    mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
+                            // +z, -z), for the one layered draw of all six (rsm_cube.vert)
 };
 
 // light_kind.x: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).

@@ -23,6 +23,8 @@ pub struct FrameUniforms {
     pub light_cone: [f32; 4],
     /// x: `LIGHT_*`; y: cube face; z: light index.
     pub light_kind: [i32; 4],
+    /// Point lights: world -> clip of each cube face, for the layered draw.
+    pub cube_view_proj: [[[f32; 4]; 4]; 6],
 }
 
 /// `light_kind.x` values, as in `shaders/shared.glsl`.

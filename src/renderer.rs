@@ -16,6 +16,7 @@ use crate::gpu_types::{FrameUniforms, LightPatch};
 use crate::methods::IndirectMethod;
 use crate::multires::MultiresBuffer;
 use crate::passes::light_sum::{LightSumPass, SumStep};
+use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::RsmTreePass;
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::readback::{self, MultiresReadback, Readback};
@@ -153,6 +154,8 @@ pub struct Renderer<'g> {
     /// Renders only this view (tests look at one cube face's RSM).
     only_view: Option<usize>,
     light_sum: Option<LightSumPass>,
+    /// Point lights' layered cube RSM (made only when the scene has one).
+    rsm_cube: Option<CubeRsmPass>,
     method: Box<dyn IndirectMethod>,
     rsm: ScenePass,
     gbuffer: ScenePass,
@@ -218,6 +221,11 @@ impl<'g> Renderer<'g> {
         } else {
             None
         };
+        let rsm_cube = if views.iter().any(|v| v.face.is_some()) {
+            Some(CubeRsmPass::new(&setup)?)
+        } else {
+            None
+        };
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
@@ -239,6 +247,7 @@ impl<'g> Renderer<'g> {
             views,
             only_view: None,
             light_sum,
+            rsm_cube,
             method,
             rsm,
             gbuffer,
@@ -340,6 +349,16 @@ impl<'g> Renderer<'g> {
             .iter()
             .map(|&v| (active.len() > 1).then(|| self.views[v].label()))
             .collect();
+        // A point light's cube is drawn before the first of its faces this frame.
+        let cube_first: Vec<Option<u32>> = active
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let view = &self.views[v];
+                let first = i == 0 || self.views[active[i - 1]].light != view.light;
+                view.face.filter(|_| first).map(|_| view.light as u32)
+            })
+            .collect();
         let Self {
             slots,
             method,
@@ -366,8 +385,20 @@ impl<'g> Renderer<'g> {
         p.begin_frame(gpu, cmds[0]);
         let mut c = 0;
         for (i, &v) in active.iter().enumerate() {
-            p.set_label(labels[i].clone());
-            self.rsm.record(&ctx(cmds[c], v), p);
+            match (self.views[v].face, &self.rsm_cube) {
+                (Some(face), Some(cube)) => {
+                    if let Some(light) = cube_first[i] {
+                        p.set_label((active.len() > 1).then(|| light.to_string()));
+                        cube.record_cube(&ctx(cmds[c], v), p);
+                    }
+                    p.set_label(labels[i].clone());
+                    cube.record_face(&ctx(cmds[c], v), p, face as u32);
+                }
+                _ => {
+                    p.set_label(labels[i].clone());
+                    self.rsm.record(&ctx(cmds[c], v), p);
+                }
+            }
             if i == 0 {
                 p.set_label(None);
                 self.gbuffer.record(&ctx(cmds[c], v), p);

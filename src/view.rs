@@ -66,6 +66,9 @@ pub struct LightView {
     pub half_extent: f32,
     /// Orthographic: the depth range it covers (m); 0 for perspective views.
     pub depth_range: f32,
+    /// A point light's six faces' `view_proj` (every face view holds all
+    /// six: the cube is rendered in one layered draw); zero otherwise.
+    pub cube: [Mat4; 6],
 }
 
 impl LightView {
@@ -107,23 +110,28 @@ pub fn light_views(
             direction: light.direction,
             half_extent: rsm_half_fov(light).tan(),
             depth_range: 0.0,
+            cube: [Mat4::ZERO; 6],
         }],
-        LightKind::Point => (0..6)
-            .map(|f| {
+        LightKind::Point => {
+            let cube: [Mat4; 6] = std::array::from_fn(|f| {
                 let axis = cube_face_axis(f);
                 let view = Mat4::look_at_rh(light.position, light.position + axis, up_for(axis));
-                LightView {
+                projection(std::f32::consts::FRAC_PI_2, 1.0, near) * view
+            });
+            (0..6)
+                .map(|f| LightView {
                     light: index,
                     kind: LightKind::Point,
                     face: Some(f),
-                    view_proj: projection(std::f32::consts::FRAC_PI_2, 1.0, near) * view,
+                    view_proj: cube[f],
                     position: light.position,
-                    direction: axis,
+                    direction: cube_face_axis(f),
                     half_extent: 1.0,
                     depth_range: 0.0,
-                }
-            })
-            .collect(),
+                    cube,
+                })
+                .collect()
+        }
         LightKind::Directional => vec![directional_view(index, light, bounds, rsm_resolution)],
     }
 }
@@ -177,5 +185,6 @@ fn directional_view(index: usize, light: &Light, (lo, hi): (Vec3, Vec3), r: u32)
         direction: d,
         half_extent: half,
         depth_range: range,
+        cube: [Mat4::ZERO; 6],
     }
 }

@@ -93,7 +93,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", light_kind: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", cube_view_proj: 384, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -103,6 +103,7 @@ fn frame_uniforms_match_shared_glsl() {
             light_intensity => "light_intensity",
             light_cone => "light_cone",
             light_kind => "light_kind",
+            cube_view_proj => "cube_view_proj",
         ]);
     }
 }

@@ -547,3 +547,27 @@ fn isr_merges_a_flat_floor_under_cube_faces_and_orthographic_rsms() {
     }
     assert_validation_clean(&gpu);
 }
+
+#[test]
+fn a_point_light_is_one_layered_draw_and_six_faces_each_timed_by_name() {
+    let gpu = gpu();
+    let scene = cornell_with(vec![box_point(), box_sun()]);
+    let settings = RenderSettings {
+        width: 32,
+        height: 32,
+        rsm_resolution: 32,
+        ..Default::default()
+    };
+    let stats = render(&gpu, &scene, &settings, 1).stats;
+    let names: Vec<&str> = stats.frames[0].iter().map(|p| p.name).collect();
+    let count = |n: &str| names.iter().filter(|&&x| x == n).count();
+    assert_eq!(count("rsm-cube[0]"), 1, "{names:?}");
+    for face in ["+x", "-x", "+y", "-y", "+z", "-z"] {
+        assert_eq!(count(&format!("rsm-face[0{face}]")), 1, "{names:?}");
+        assert_eq!(count(&format!("gather[0{face}]")), 1, "{names:?}");
+    }
+    assert_eq!(count("rsm[1]"), 1, "the sun's own RSM: {names:?}");
+    assert_eq!(count("gbuffer"), 1, "{names:?}");
+    assert_eq!(count("light-sum[1]"), 1, "{names:?}");
+    assert!(!names.contains(&"rsm"), "{names:?}");
+}

@@ -79,7 +79,10 @@ pub fn check_light_views(
             lights.len()
         );
     }
-    let extra = light_memory_estimate(s, views, instances);
+    let cube = lights
+        .iter()
+        .any(|l| l.kind == crate::scene::LightKind::Point);
+    let extra = light_memory_estimate(s, views, instances, cube);
     let needed = memory_estimate(s) + extra;
     let heap = device_local_heap(gpu);
     if heap > 0 && needed > heap / 10 * 9 {
@@ -97,9 +100,15 @@ pub fn check_light_views(
 /// Bytes that lights add to `memory_estimate`. The views of a frame run one
 /// after another and reuse the one RSM, its quadtree and the method's
 /// buffers; what grows with them is a frame set per view and frame in flight
-/// (uniforms and instance transforms, host-visible), and with more than one
-/// view the two full-resolution sums of `light-sum`.
-pub fn light_memory_estimate(s: &RenderSettings, views: usize, instances: usize) -> u64 {
+/// (uniforms and instance transforms, host-visible), with more than one view
+/// the two full-resolution sums of `light-sum`, and with point lights (`cube`)
+/// the six-layer cube RSM they share.
+pub fn light_memory_estimate(
+    s: &RenderSettings,
+    views: usize,
+    instances: usize,
+    cube: bool,
+) -> u64 {
     let frame_set = std::mem::size_of::<crate::gpu_types::FrameUniforms>() as u64
         + instances.max(1) as u64
             * std::mem::size_of::<crate::gpu_types::InstanceTransform>() as u64;
@@ -109,7 +118,12 @@ pub fn light_memory_estimate(s: &RenderSettings, views: usize, instances: usize)
     } else {
         0
     };
-    sets + sums
+    let cube = if cube {
+        crate::passes::rsm_cube::cube_bytes(s.rsm_resolution)
+    } else {
+        0
+    };
+    sets + sums + cube
 }
 
 /// Bytes of GPU memory the targets, readback buffers and the method's

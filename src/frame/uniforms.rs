@@ -34,6 +34,7 @@ pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, v: &LightView) -> 
         light_intensity: intensity.extend(intensity.max_element()).to_array(),
         light_cone: [scale, offset, v.half_extent, v.depth_range],
         light_kind: [kind, v.face.unwrap_or(0) as i32, v.light as i32, 0],
+        cube_view_proj: v.cube.map(|m| m.to_cols_array_2d()),
     }
 }
 
