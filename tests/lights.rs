@@ -320,12 +320,30 @@ fn box_sun() -> Light {
 #[test]
 fn two_lights_render_as_the_sum_of_each_alone() {
     let gpu = gpu();
-    for method in [Method::MultiresGather, Method::Hisr] {
+    // Every GPU method; the reference in several submissions per light view.
+    let methods = [
+        Method::None,
+        Method::MultiresGather,
+        Method::Isr,
+        Method::Hisr,
+        Method::RsmGather,
+        Method::RsmSplat,
+        Method::RsmSplatRestricted,
+        Method::MultiresSplat,
+        Method::Reference,
+    ];
+    for method in methods {
         let settings = RenderSettings {
-            width: 64,
-            height: 64,
-            rsm_resolution: 64,
+            width: 48,
+            height: 48,
+            rsm_resolution: 32,
+            vpls: 64,
             method,
+            reference_chunk: 48 * 48 * 32 * 8,
+            light_tree: LightTreeSettings {
+                isr_base: 16,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let read = |lights| render(&gpu, &cornell_with(lights), &settings, 1).readback;
@@ -344,7 +362,7 @@ fn two_lights_render_as_the_sum_of_each_alone() {
             let (s, x, y) = (get(&both), get(&a), get(&b));
             let total = |v: &[[f32; 4]]| v.iter().map(|t| t[0] as f64).sum::<f64>();
             assert!(
-                total(&x) > 0.0 && total(&y) > 0.0,
+                (layer == 1 && method == Method::None) || (total(&x) > 0.0 && total(&y) > 0.0),
                 "each light alone lights the box"
             );
             for i in 0..s.len() {
