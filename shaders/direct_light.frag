@@ -1,10 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Direct light (docs/algorithm.md section 2):
-//   L_direct = rho/pi * I(w) * max(0, n.l) / r^2 * V
-// with V from the RSM depth: 3x3 taps of hardware 2x2 PCF.
+// Direct light of one light view (docs/algorithm.md sections 2.3 and 2.4):
+//   L_direct = rho/pi * I(w) * max(0, n.l) / r^2 * V   (spot; point, this cube face's points)
+//   L_direct = rho/pi * E * max(0, n.l) * V            (directional)
+// with V from the RSM depth: 3x3 taps of hardware 2x2 PCF. Several views add up
+// (renderer: light_sum.comp).
 #include "frame.glsl"
-#include "lighting.glsl"
+#include "light_types.glsl"
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
@@ -15,21 +17,19 @@ layout(location = 0) out vec4 out_radiance;  // rgb: W/(m^2 sr)
 
 float visibility(vec3 p, vec3 n, float cos_i) {
     float res = float(run.size.z);
-    float dist = dot(p - u.light_position.xyz, u.light_direction.xyz);
     // One RSM texel spans this many metres at the receiver's depth.
-    float texel_world = 2.0 * u.light_cone.z * max(dist, 0.0) / res;
+    float texel_world = shadow_texel_world(p);
     vec4 clip = u.light_view_proj * vec4(p + n * (run.shadow.x * texel_world), 1.0);
     if (clip.w <= 0.0) return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
-    // Reversed-Z depth is near/z: larger is closer to the light. The receiver is
-    // lit when it is at least as close as the stored occluder. Within one texel
-    // (and across the PCF footprint) a surface tilted by theta from the light
-    // changes depth by texel * tan(theta): bias by that many texels, as a
-    // relative change of z (d(near/z) / (near/z) = -dz / z).
+    // Reversed-Z depth: larger is closer to the light. The receiver is lit when
+    // it is at least as close as the stored occluder. Within one texel (and
+    // across the PCF footprint) a surface tilted by theta from the light
+    // changes depth by texel * tan(theta): bias by that many texels
+    // (shadow_reference in light_types.glsl).
     float tan_theta = min(sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-3), 20.0);
-    float texel_angle = 2.0 * u.light_cone.z / res;
-    float ref = ndc.z * (1.0 + run.shadow.y + run.shadow.w * texel_angle * tan_theta);
+    float ref = shadow_reference(ndc.z, tan_theta, texel_world);
     float radius = run.shadow.z;
     float sum = 0.0;
     for (int y = -1; y <= 1; ++y)
@@ -48,10 +48,10 @@ void main() {
     vec3 p = position.xyz;
     vec3 n = texelFetch(gbuffer_normal, pixel, 0).xyz;
     vec3 albedo = texelFetch(gbuffer_albedo, pixel, 0).rgb;
-    vec3 to_light = u.light_position.xyz - p;
-    float r2 = dot(to_light, to_light);
-    float cos_i = max(dot(n, to_light * inversesqrt(r2)), 0.0);
-    vec3 radiance = albedo / PI * spot_intensity(u, p) * cos_i / r2;
+    float r2;
+    vec3 l = light_direction_from(p, r2);
+    float cos_i = max(dot(n, l), 0.0);
+    vec3 radiance = albedo / PI * light_intensity_toward(p, u.light_kind.y) * cos_i / r2;
     if (cos_i > 0.0) radiance *= visibility(p, n, cos_i);
     out_radiance = vec4(radiance, 1.0);
 }

@@ -11,7 +11,7 @@
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
-#include "lighting.glsl"
+#include "light_types.glsl"
 #include "multires.glsl"
 #include "vpl.glsl"
 
@@ -76,7 +76,8 @@ void chosen_list(vec3 xi, vec3 ni) {
 // constant per frame (light_tree.x; `--tau` is tau / I, so T = 2 (1 - tau) /
 // (3 tau R^2)). The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
-// R^2 / 4^k and its threshold 4^k T.
+// R^2 / 4^k and its threshold 4^k T. For cube faces and orthographic RSMs
+// the right-hand side differs: hisr_bound in light_types.glsl derives it.
 //
 // Invalid patches (spanning a discontinuity) are held to a tighter test: the
 // bound above drops both cosines, so it holds for them too, but their mean
@@ -104,7 +105,6 @@ void traverse(vec3 xi, vec3 ni) {
     int start = run.light_levels.x;
     int max_depth = run.light_levels.y;
     float t_finest = run.light_tree.x;
-    vec3 light = u.light_position.xyz;
     ivec3 stack[STACK_SIZE];  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     int side = 1 << start;
     for (int s = 0; s < side * side; ++s) {
@@ -118,8 +118,7 @@ void traverse(vec3 xi, vec3 ni) {
             if (node.z < max_depth && sp + 4 <= STACK_SIZE) {
                 int mip = top - node.z;
                 vec3 vij = lp.position_area.xyz - xi;
-                vec3 vj = lp.position_area.xyz - light;
-                float reach = exp2(float(2 * mip)) * t_finest * dot(vj, vj);
+                float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, t_finest);
                 if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
                 split = dot(vij, vij) <= reach;
             }

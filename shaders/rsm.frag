@@ -1,48 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Reflective shadow map (docs/algorithm.md section 2). Texel j holds the point x_j it
-// sees, its normal n_j, the VPL flux Phi_j = rho_j * I(w_j) * dw_j and world
-// area A_j = dw_j * r_j^2 / cos_j. Depth goes to the depth attachment.
-#include "frame.glsl"
-#include "lighting.glsl"
+// Reflective shadow map of a spot or directional light (docs/algorithm.md
+// sections 2.3 and 2.4), drawn with scene.vert: see rsm_texel.glsl.
+#include "rsm_texel.glsl"
 
-layout(push_constant) uniform Push { DrawPush draw; };
-#include "material.glsl"
-
-layout(location = 0) in vec3 in_world;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-
-// The layout every level of the RSM quadtree shares (see rsm_tree.comp).
-layout(location = 0) out vec4 out_position;  // xyz: x_j (m); w: A_j (m^2), 0 where nothing lit was seen
-layout(location = 1) out vec4 out_normal;    // xyz: n_j; w: PATCH_VALID (1) where lit geometry was seen
-layout(location = 2) out vec4 out_flux;      // rgb: Phi_j (W); a: dw_j (sr)
-
-// Smallest cosine used for A_j: a surface seen edge-on by the light would get an
-// unbounded area; 0.01 caps it at 100x the facing area.
-const float MIN_COS_J = 0.01;
-
-void main() {
-    vec3 n = facing_normal(in_normal);
-    float res = float(run.size.z);
-    float tan_half = u.light_cone.z;
-    // The texel center's point on the image plane at unit distance from the light.
-    vec2 plane = (gl_FragCoord.xy / res * 2.0 - 1.0) * tan_half;
-    float cos_alpha = inversesqrt(1.0 + dot(plane, plane));
-    float texel = 2.0 * tan_half / res;
-    float dw = texel * texel * cos_alpha * cos_alpha * cos_alpha;
-
-    vec3 to_light = u.light_position.xyz - in_world;
-    float r2 = dot(to_light, to_light);
-    float cos_j = max(dot(n, to_light * inversesqrt(r2)), MIN_COS_J);
-    vec3 albedo = material_albedo(draw.material, in_uv);
-
-    // Texels outside the cone (about 21% of a square RSM around a round cone)
-    // carry no power: they are empty patches, so no light-space method spends
-    // work on them and they do not pull the means of patches on the cone edge.
-    vec3 intensity = spot_intensity(u, in_world);
-    bool lit = max(intensity.r, max(intensity.g, intensity.b)) > 0.0;
-    out_position = vec4(in_world, lit ? dw * r2 / cos_j : 0.0);
-    out_normal = vec4(n, lit ? 1.0 : 0.0);
-    out_flux = vec4(albedo * intensity * dw, dw);
-}
+void main() { write_rsm_texel(u.light_kind.y); }

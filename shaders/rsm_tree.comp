@@ -6,13 +6,15 @@
 //
 // Validity (normal.w, see PATCH_*): a patch is valid when all its non-empty
 // children are valid and lie on one surface: each child's mean within the
-// depth threshold (relative to its distance to the light) of the patch's
+// depth threshold (relative to its distance to the light, or for an orthographic
+// RSM to its half side: validity_reach in light_types.glsl) of the patch's
 // plane, and its normal within the angle threshold of the patch's normal.
 // Children's means are compared rather than full ranges, so a patch keeps only
 // a flag; since validity needs valid children, a discontinuity anywhere below
 // invalidates every ancestor.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
+#include "light_types.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 
@@ -55,7 +57,7 @@ void main() {
         for (int i = 0; i < 4; ++i) {
             if (child_normal[i].w == PATCH_EMPTY) continue;
             float offset = abs(dot(child_position[i].xyz - position, normal));
-            float reach = run.light_tree.y * distance(child_position[i].xyz, u.light_position.xyz);
+            float reach = run.light_tree.y * validity_reach(child_position[i].xyz);
             one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > run.light_tree.z;
         }
         state = one_surface ? PATCH_VALID : PATCH_INVALID;

@@ -15,9 +15,20 @@ struct FrameUniforms {
     vec4 light_direction;   // xyz: unit spot axis
     vec4 light_intensity;   // rgb: color * intensity, W/sr (candela read as W/sr); w: I, the
                             // peak of rgb (W/sr)
-    vec4 light_cone;        // x, y: KHR_lights_punctual lightAngleScale, lightAngleOffset;
-                            // z: tan(RSM half field of view); w: unused
+    vec4 light_cone;        // x, y: KHR_lights_punctual lightAngleScale, lightAngleOffset (spot);
+                            // z: tan(RSM half field of view) (spot, point), or half the side of
+                            // the orthographic RSM (m, directional); w: the orthographic RSM's
+                            // depth range (m, directional)
+    ivec4 light_kind;       // x: LIGHT_*; y: cube face of a point light (0..5: +x, -x, +y, -y, +z, -z);
+                            // z: index of the light in the scene; w: unused
+    mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
+                            // +z, -z), for the one layered draw of all six (rsm_cube.vert)
 };
+
+// light_kind.x: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
+const int LIGHT_SPOT = 0;         // perspective, the square around the outer cone
+const int LIGHT_POINT = 1;        // one 90 degree cube face; six make the point light
+const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 
 // What is fixed for a run: sizes, thresholds, levels (std140 uniform block,
 // set 0 binding 1, written once).

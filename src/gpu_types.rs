@@ -18,9 +18,19 @@ pub struct FrameUniforms {
     pub light_direction: [f32; 4],
     /// rgb: color * intensity in W/sr; w: the peak of rgb, I.
     pub light_intensity: [f32; 4],
-    /// x, y: KHR angle scale and offset; z: tan(RSM half fov); w: unused.
+    /// x, y: KHR angle scale and offset; z: tan(RSM half fov), or half the
+    /// orthographic RSM's side (m); w: the orthographic depth range (m).
     pub light_cone: [f32; 4],
+    /// x: `LIGHT_*`; y: cube face; z: light index.
+    pub light_kind: [i32; 4],
+    /// Point lights: world -> clip of each cube face, for the layered draw.
+    pub cube_view_proj: [[[f32; 4]; 4]; 6],
 }
+
+/// `light_kind.x` values, as in `shaders/shared.glsl`.
+pub const LIGHT_SPOT: i32 = 0;
+pub const LIGHT_POINT: i32 = 1;
+pub const LIGHT_DIRECTIONAL: i32 = 2;
 
 /// `RunUniforms` (std140): what is fixed for a run.
 #[repr(C)]

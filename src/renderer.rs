@@ -9,25 +9,27 @@
 //! between frames (camera, light, instance transforms) is data in the frame
 //! set of the frame's slot, written just before it is submitted.
 
-use crate::frame::check::check_settings;
+use crate::frame::check::{check_light_views, check_settings};
 use crate::frame::uniforms::{frame_uniforms, instance_transforms, run_uniforms};
 use crate::frame::{FrameContext, FrameSet, Samplers, SceneGpu, Setup, Targets};
 use crate::gpu_types::{FrameUniforms, LightPatch};
 use crate::methods::IndirectMethod;
 use crate::multires::MultiresBuffer;
+use crate::passes::light_sum::{LightSumPass, SumStep};
+use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::RsmTreePass;
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::readback::{self, MultiresReadback, Readback};
 use crate::scene::{FrameState, Scene};
 use crate::settings::RenderSettings;
+use crate::view::{light_views, LightView};
 use crate::vk::profiler::{PassSample, Profiler};
 use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use std::time::Instant;
 
-/// Frames recorded and submitted ahead of the one being waited for.
-pub const FRAMES_IN_FLIGHT: usize = 2;
+pub use crate::frame::FRAMES_IN_FLIGHT;
 
 /// Passes a frame can hold besides the method's repeated ones; the profiler's
 /// query pools are this large.
@@ -87,10 +89,11 @@ pub struct FrameProgress {
     pub submissions: u32,
 }
 
-/// One frame in flight: its frame set, command buffers, queries and fence.
+/// One frame in flight: its frame sets (one per light view), command
+/// buffers, queries and fence.
 struct Slot<'g> {
     gpu: &'g Gpu,
-    frame: FrameSet,
+    frames: Vec<FrameSet>,
     profiler: Profiler,
     cmds: Vec<vk::CommandBuffer>,
     fence: vk::Fence,
@@ -99,8 +102,16 @@ struct Slot<'g> {
 }
 
 impl<'g> Slot<'g> {
-    fn new(gpu: &'g Gpu, run: &Buffer, instances: usize, passes: u32) -> Result<Self> {
-        let frame = FrameSet::new(gpu, run, instances)?;
+    fn new(
+        gpu: &'g Gpu,
+        run: &Buffer,
+        instances: usize,
+        views: usize,
+        passes: u32,
+    ) -> Result<Self> {
+        let frames = (0..views)
+            .map(|_| FrameSet::new(gpu, run, instances))
+            .collect::<Result<Vec<_>>>()?;
         let profiler = Profiler::new(gpu, passes)?;
         let fence = unsafe {
             gpu.device
@@ -108,7 +119,7 @@ impl<'g> Slot<'g> {
         }?;
         Ok(Self {
             gpu,
-            frame,
+            frames,
             profiler,
             cmds: Vec::new(),
             fence,
@@ -144,9 +155,18 @@ impl Drop for Slot<'_> {
 pub struct Renderer<'g> {
     gpu: &'g Gpu,
     pub settings: RenderSettings,
-    /// The diagonal of the scene's bounds as loaded (places the RSM near plane).
-    scene_extent: f32,
+    /// The scene's bounds as loaded: they place the RSM near plane and fit
+    /// directional lights' RSMs.
+    bounds: (glam::Vec3, glam::Vec3),
     state: FrameState,
+    /// Every RSM a frame renders: one per spot or directional light, six per
+    /// point light (`view::light_views`), from the current frame state.
+    views: Vec<LightView>,
+    /// Renders only this view (tests look at one cube face's RSM).
+    only_view: Option<usize>,
+    light_sum: Option<LightSumPass>,
+    /// Point lights' layered cube RSM (made only when the scene has one).
+    rsm_cube: Option<CubeRsmPass>,
     method: Box<dyn IndirectMethod>,
     rsm: ScenePass,
     gbuffer: ScenePass,
@@ -168,6 +188,16 @@ impl<'g> Renderer<'g> {
     /// shows `scene.rest_state()`. Whatever was made before an error is freed.
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
         check_settings(gpu, settings)?;
+        let bounds = scene.bounds().unwrap_or((glam::Vec3::ZERO, glam::Vec3::X));
+        let state = scene.rest_state();
+        let views = all_views(&state, bounds, settings.rsm_resolution);
+        check_light_views(
+            gpu,
+            settings,
+            &scene.lights,
+            views.len(),
+            scene.instances.len(),
+        )?;
         let samplers = Samplers::new(gpu)?;
         let scene_gpu =
             SceneGpu::new(gpu, scene, samplers.texture).context("uploading the scene")?;
@@ -197,17 +227,38 @@ impl<'g> Renderer<'g> {
         let rsm_tree = RsmTreePass::new(&setup)?;
         let composite = composite::new(&setup)?;
         let tonemap = tonemap::new(&setup)?;
+        let light_sum = if views.len() > 1 {
+            Some(LightSumPass::new(&setup)?)
+        } else {
+            None
+        };
+        let rsm_cube = if views.iter().any(|v| v.face.is_some()) {
+            Some(CubeRsmPass::new(&setup)?)
+        } else {
+            None
+        };
         drop(first);
-        let passes = MAX_PASSES + method.submissions() as u32;
+        let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
-            .map(|_| Slot::new(gpu, &run_uniforms, scene.instances.len(), passes))
+            .map(|_| {
+                Slot::new(
+                    gpu,
+                    &run_uniforms,
+                    scene.instances.len(),
+                    views.len(),
+                    passes,
+                )
+            })
             .collect::<Result<Vec<_>>>()?;
-        let scene_extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         Ok(Self {
             gpu,
             settings: settings.clone(),
-            scene_extent,
-            state: scene.rest_state(),
+            bounds,
+            state,
+            views,
+            only_view: None,
+            light_sum,
+            rsm_cube,
             method,
             rsm,
             gbuffer,
@@ -235,13 +286,61 @@ impl<'g> Renderer<'g> {
                 self.scene.instance_count
             );
         }
+        let kinds = |s: &FrameState| s.lights.iter().map(|l| l.kind).collect::<Vec<_>>();
+        if kinds(state) != kinds(&self.state) {
+            bail!(
+                "a frame state's lights ({:?}) differ in number or kind from the scene's ({:?})",
+                kinds(state),
+                kinds(&self.state)
+            );
+        }
         self.state = state.clone();
+        self.views = all_views(&self.state, self.bounds, self.settings.rsm_resolution);
         Ok(())
     }
 
-    /// The frame uniforms of the current frame state.
+    /// The frame uniforms of the current frame state, seen from the first
+    /// light view.
     pub fn frame_uniforms(&self) -> FrameUniforms {
-        frame_uniforms(&self.state, &self.settings, self.scene_extent)
+        self.view_uniforms(0)
+    }
+
+    /// The frame uniforms of light view `v` (an index into `light_views`).
+    pub fn view_uniforms(&self, v: usize) -> FrameUniforms {
+        frame_uniforms(&self.state, &self.settings, &self.views[v])
+    }
+
+    /// The RSMs each frame renders, in order.
+    pub fn light_views(&self) -> &[LightView] {
+        &self.views
+    }
+
+    /// Renders only light view `v` from now on (`None`: all), as if its
+    /// light were alone and that view its only RSM: the targets then hold that
+    /// view's RSM and light tree.
+    pub fn set_only_view(&mut self, v: Option<usize>) -> Result<()> {
+        if let Some(v) = v {
+            if v >= self.views.len() {
+                bail!("light view {v} does not exist ({} views)", self.views.len());
+            }
+        }
+        self.only_view = v;
+        Ok(())
+    }
+
+    /// The views a frame renders: all, or the one `set_only_view` chose.
+    fn active_views(&self) -> Vec<usize> {
+        match self.only_view {
+            Some(v) => vec![v],
+            None => (0..self.views.len()).collect(),
+        }
+    }
+
+    /// Command buffers (submissions) of one frame: a method that needs S
+    /// submissions per view starts a new one for each of its chunks after
+    /// the first.
+    fn submissions(&self) -> usize {
+        1 + self.active_views().len() * (self.method.submissions() - 1)
     }
 
     /// The method's passes and resources.
@@ -249,11 +348,29 @@ impl<'g> Renderer<'g> {
         self.method.as_ref()
     }
 
-    /// Records `slot`'s frame: the shared passes around the method's, then
+    /// Records `slot`'s frame: the G-buffer, then for each light view its
+    /// RSM, direct light, light tree and method passes (summed by
+    /// `light-sum` when there are several), then the composite, tonemap and
     /// what `extension` adds (the viewer's presentation).
     fn record(&mut self, slot: usize, extension: Option<&mut dyn FrameExtension>) -> Result<()> {
         let gpu = self.gpu;
-        let submissions = self.method.submissions();
+        let chunks = self.method.submissions();
+        let active = self.active_views();
+        let total = self.submissions();
+        let labels: Vec<Option<String>> = active
+            .iter()
+            .map(|&v| (active.len() > 1).then(|| self.views[v].label()))
+            .collect();
+        // A point light's cube is drawn before the first of its faces this frame.
+        let cube_first: Vec<Option<u32>> = active
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let view = &self.views[v];
+                let first = i == 0 || self.views[active[i - 1]].light != view.light;
+                view.face.filter(|_| first).map(|_| view.light as u32)
+            })
+            .collect();
         let Self {
             slots,
             method,
@@ -262,39 +379,73 @@ impl<'g> Renderer<'g> {
             ..
         } = self;
         let slot = &mut slots[slot];
-        let cmds = slot.command_buffers(submissions)?.to_vec();
+        let cmds = slot.command_buffers(total)?.to_vec();
         let begin = |cmd| unsafe {
             gpu.device
                 .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
         };
-        let ctx = |cmd| FrameContext {
+        let sets: Vec<vk::DescriptorSet> = slot.frames.iter().map(|f| f.set.set).collect();
+        let ctx = |cmd, v: usize| FrameContext {
             gpu,
             cmd,
-            frame_set: slot.frame.set.set,
+            frame_set: sets[v],
             scene,
             targets,
         };
         let p = &mut slot.profiler;
         begin(cmds[0])?;
         p.begin_frame(gpu, cmds[0]);
-        self.rsm.record(&ctx(cmds[0]), p);
-        self.gbuffer.record(&ctx(cmds[0]), p);
-        self.direct.record(&ctx(cmds[0]), p);
-        if method.reads_rsm_tree() {
-            self.rsm_tree.record(&ctx(cmds[0]), p);
-        }
-        for (k, &cmd) in cmds.iter().enumerate() {
-            if k > 0 {
-                unsafe { gpu.device.end_command_buffer(cmds[k - 1])? };
-                begin(cmd)?;
+        let mut c = 0;
+        for (i, &v) in active.iter().enumerate() {
+            match (self.views[v].face, &self.rsm_cube) {
+                (Some(face), Some(cube)) => {
+                    if let Some(light) = cube_first[i] {
+                        p.set_label((active.len() > 1).then(|| light.to_string()));
+                        cube.record_cube(&ctx(cmds[c], v), p);
+                    }
+                    p.set_label(labels[i].clone());
+                    cube.record_face(&ctx(cmds[c], v), p, face as u32);
+                }
+                _ => {
+                    p.set_label(labels[i].clone());
+                    self.rsm.record(&ctx(cmds[c], v), p);
+                }
             }
-            method.record(&ctx(cmd), p, k);
+            if i == 0 {
+                p.set_label(None);
+                self.gbuffer.record(&ctx(cmds[c], v), p);
+                p.set_label(labels[i].clone());
+            }
+            self.direct.record(&ctx(cmds[c], v), p);
+            if method.reads_rsm_tree() {
+                self.rsm_tree.record(&ctx(cmds[c], v), p);
+            }
+            for k in 0..chunks {
+                if k > 0 {
+                    unsafe { gpu.device.end_command_buffer(cmds[c])? };
+                    c += 1;
+                    begin(cmds[c])?;
+                }
+                method.record(&ctx(cmds[c], v), p, k);
+            }
+            if let Some(sum) = &self.light_sum {
+                if active.len() > 1 {
+                    let step = match i {
+                        0 => SumStep::First,
+                        _ if i + 1 == active.len() => SumStep::Last,
+                        _ => SumStep::Middle,
+                    };
+                    sum.record(&ctx(cmds[c], v), p, step);
+                }
+            }
         }
-        let last = cmds[submissions - 1];
-        self.composite.record(&ctx(last), p);
-        self.tonemap.record(&ctx(last), p);
+        p.set_label(None);
+        let last = cmds[c];
+        debug_assert_eq!(c + 1, total);
+        self.composite.record(&ctx(last, active[0]), p);
+        self.tonemap.record(&ctx(last, active[0]), p);
         if let Some(e) = extension {
-            e.record(&ctx(last), p)?;
+            e.record(&ctx(last, active[0]), p)?;
         }
         unsafe { gpu.device.end_command_buffer(last)? };
         Ok(())
@@ -324,7 +475,7 @@ impl<'g> Renderer<'g> {
     ) -> Result<FrameStats> {
         let gpu = self.gpu;
         let mut stats = FrameStats::default();
-        let submissions = self.method.submissions() as u32;
+        let submissions = self.submissions() as u32;
         let started = Instant::now();
         let report = |stats: &FrameStats, submission| FrameProgress {
             frame: stats.frames.len() as u32,
@@ -341,9 +492,11 @@ impl<'g> Renderer<'g> {
             if had_frame {
                 progress(report(&stats, 0));
             }
-            let uniforms = self.frame_uniforms();
             let transforms = instance_transforms(&self.state);
-            self.slots[slot].frame.write(&uniforms, &transforms);
+            for v in 0..self.views.len() {
+                let uniforms = self.view_uniforms(v);
+                self.slots[slot].frames[v].write(&uniforms, &transforms);
+            }
             self.record(slot, None)?;
             let s = &mut self.slots[slot];
             let submitted = Instant::now();
@@ -400,12 +553,14 @@ impl<'g> Renderer<'g> {
         let finished = self.wait_next_slot()?;
         let slot = self.next_slot;
         self.next_slot = (slot + 1) % self.slots.len();
-        let uniforms = self.frame_uniforms();
         let transforms = instance_transforms(&self.state);
-        self.slots[slot].frame.write(&uniforms, &transforms);
+        for v in 0..self.views.len() {
+            let uniforms = self.view_uniforms(v);
+            self.slots[slot].frames[v].write(&uniforms, &transforms);
+        }
         self.record(slot, Some(&mut *extension))?;
+        let submissions = self.submissions();
         let s = &mut self.slots[slot];
-        let submissions = self.method.submissions();
         let cmds = s.cmds[..submissions].to_vec();
         for &cmd in &cmds[..submissions - 1] {
             gpu.submit_and_wait(cmd)?;
@@ -430,7 +585,7 @@ impl<'g> Renderer<'g> {
     /// A frame set: the layout of set 0 for pipelines made outside the
     /// renderer (all frame sets share one definition).
     pub fn frame_set_layout(&self) -> &crate::vk::pipeline::DescriptorSet {
-        &self.slots[0].frame.set
+        &self.slots[0].frames[0].set
     }
 
     /// Waits until no frame is in flight (before reading results back or
@@ -462,14 +617,14 @@ impl<'g> Renderer<'g> {
         let gpu = self.gpu;
         let setup = Setup {
             gpu,
-            frame: &self.slots[0].frame.set,
+            frame: &self.slots[0].frames[0].set,
             targets: &self.targets,
             samplers: &self._samplers,
             scene: &self.scene,
             settings,
         };
         let method = crate::methods::create(&setup)?;
-        let passes = MAX_PASSES + method.submissions() as u32;
+        let passes = (MAX_PASSES + method.submissions() as u32) * self.views.len() as u32;
         for slot in &mut self.slots {
             slot.profiler = Profiler::new(gpu, passes)?;
         }
@@ -531,6 +686,16 @@ impl<'g> Renderer<'g> {
     pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
         Ok(self.isr_chosen()?.map(|c| c.len() as u32))
     }
+}
+
+/// Every light view of `state`'s lights, in light order.
+fn all_views(state: &FrameState, bounds: (glam::Vec3, glam::Vec3), rsm: u32) -> Vec<LightView> {
+    state
+        .lights
+        .iter()
+        .enumerate()
+        .flat_map(|(i, l)| light_views(i, l, bounds, rsm))
+        .collect()
 }
 
 impl Drop for Renderer<'_> {

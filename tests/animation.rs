@@ -180,9 +180,10 @@ fn nested_animated_nodes_compose_parent_then_child() {
     eye.w_axis += Vec4::new(2.0 * sn, 0.0, 2.0 * c, 0.0);
     assert!(st.camera.world_from_camera.abs_diff_eq(eye, 1e-6));
     // The light 1 m along the spinner's +Z, pointing along its -Z.
-    assert!(st.light.position.abs_diff_eq(Vec3::new(sn, 2.0, c), 1e-6));
-    assert!(st
-        .light
+    assert!(st.lights[0]
+        .position
+        .abs_diff_eq(Vec3::new(sn, 2.0, c), 1e-6));
+    assert!(st.lights[0]
         .direction
         .abs_diff_eq(Vec3::new(-sn, 0.0, -c), 1e-6));
 
@@ -245,10 +246,10 @@ fn camera_and_light_follow_their_own_animated_nodes() {
         .world_from_camera
         .abs_diff_eq(Mat4::from_translation(Vec3::new(2.0, 0.25, 5.25)), 1e-6));
     // The light: straight down until 1 s, then tilted 45 degrees toward +x.
-    let l = s.state_at(0.99).light;
+    let l = s.state_at(0.99).lights[0];
     assert!(l.position.abs_diff_eq(Vec3::new(0.0, 3.0, 0.0), 1e-6));
     assert!(l.direction.abs_diff_eq(-Vec3::Y, 1e-6));
-    let l = st.light;
+    let l = st.lights[0];
     assert!(l.direction.abs_diff_eq(Vec3::new(S45, -S45, 0.0), 1e-6));
     assert_eq!(l.intensity, 5.0);
 }
@@ -277,22 +278,26 @@ fn the_built_in_sweep_moves_the_light_only() {
     assert_eq!(s.animation_duration(), Some(4.0));
     let rest = s.rest_state();
     let at0 = s.state_at(0.0);
-    assert!(at0.light.position.abs_diff_eq(rest.light.position, 1e-6));
-    assert!(at0.light.direction.abs_diff_eq(rest.light.direction, 1e-6));
+    assert!(at0.lights[0]
+        .position
+        .abs_diff_eq(rest.lights[0].position, 1e-6));
+    assert!(at0.lights[0]
+        .direction
+        .abs_diff_eq(rest.lights[0].direction, 1e-6));
     let mut xs = vec![];
     for k in 0..=16 {
         let st = s.state_at(k as f32 * 0.25);
         assert_eq!(st.instance_transforms, rest.instance_transforms);
         assert_eq!(st.camera, rest.camera);
-        assert_eq!(st.light.position, rest.light.position);
-        xs.push(st.light.direction.x);
+        assert_eq!(st.lights[0].position, rest.lights[0].position);
+        xs.push(st.lights[0].direction.x);
     }
     // Toward +x (green wall) at 1 s, back at 2 s, toward -x at 3 s, back at 4 s.
     let tilt = 40f32.to_radians().sin();
     assert!(xs[4] > 0.6 * tilt && xs[12] < -0.6 * tilt, "{xs:?}");
     assert!(xs[8].abs() < 1e-6 && xs[16].abs() < 1e-6);
     // The axis meets the green wall (x = 1) below the ceiling at 1 s.
-    let l = s.state_at(1.0).light;
+    let l = s.state_at(1.0).lights[0];
     let y = l.position.y + l.direction.y * (1.0 - l.position.x) / l.direction.x;
     assert!((0.5..0.9).contains(&y), "meets the wall at y = {y}");
 }
@@ -347,7 +352,7 @@ fn export_round_trips_nested_animation() {
     let short_block = s.instances.len() - 2;
     a.attach_instance(short_block, spinner);
     a.attach_camera(eye);
-    a.attach_light(spinner);
+    a.attach_light(0, spinner);
     s.animation = Some(a);
     let d: Value = serde_json::from_str(&isr::scene::export::to_gltf_json(&s).unwrap()).unwrap();
     let file = load(&d, "roundtrip");
@@ -363,11 +368,13 @@ fn export_round_trips_nested_animation() {
             "t {t}"
         );
         assert!(
-            a.light.position.abs_diff_eq(b.light.position, 1e-5),
+            a.lights[0].position.abs_diff_eq(b.lights[0].position, 1e-5),
             "t {t}"
         );
         assert!(
-            a.light.direction.abs_diff_eq(b.light.direction, 1e-5),
+            a.lights[0]
+                .direction
+                .abs_diff_eq(b.lights[0].direction, 1e-5),
             "t {t}"
         );
         // Instances may come in another order from the file: match by mesh.

@@ -153,14 +153,38 @@ fn non_finite_positions() {
 }
 
 #[test]
-fn point_and_directional_lights_are_not_supported_yet() {
-    for kind in ["point", "directional"] {
-        let dir = temp_dir(kind);
+fn bad_light_values_are_refused_with_what_is_wrong() {
+    let spot = |inner: f64, outer: f64| {
+        json!({"type": "spot", "intensity": 5.0,
+            "spot": {"innerConeAngle": inner, "outerConeAngle": outer}})
+    };
+    let cases = [
+        // (light, what the message must name)
+        (json!({"type": "point", "intensity": -1.0}), "intensity -1"),
+        (
+            json!({"type": "directional", "intensity": -0.5}),
+            "intensity -0.5",
+        ),
+        // 1e39 is beyond f32: it loads as infinity.
+        (json!({"type": "point", "intensity": 1e39}), "intensity inf"),
+        (
+            json!({"type": "point", "intensity": 1.0, "color": [1.0, -0.2, 1.0]}),
+            "color",
+        ),
+        (
+            json!({"type": "directional", "intensity": 1.0, "color": [1e39, 1.0, 1.0]}),
+            "color",
+        ),
+        (spot(0.5, 0.5), "outer cone above the inner"),
+        (spot(0.6, 0.4), "outer cone above the inner"),
+        (spot(0.2, 1.7), "at most 90 degrees"),
+    ];
+    for (i, (light, what)) in cases.into_iter().enumerate() {
+        let dir = temp_dir(&format!("light{i}"));
         let mut doc = cornell_json();
-        doc["extensions"]["KHR_lights_punctual"]["lights"][0] =
-            json!({"type": kind, "intensity": 5.0});
+        doc["extensions"]["KHR_lights_punctual"]["lights"][0] = light.clone();
         let e = fails_on(&dir, &doc);
-        assert!(e.contains("not supported yet"), "{e}");
+        assert!(e.contains("light 0") && e.contains(what), "{light}: {e}");
     }
 }
 

@@ -26,8 +26,10 @@ fn every_stress_scene_asset_loads_and_matches_its_generator() {
         for t in [0.0, 0.7, 1.9, duration] {
             let (a, b) = (loaded.state_at(t), built.state_at(t));
             assert!(
-                a.light.position.abs_diff_eq(b.light.position, 1e-4)
-                    && a.light.direction.abs_diff_eq(b.light.direction, 1e-4),
+                a.lights[0].position.abs_diff_eq(b.lights[0].position, 1e-4)
+                    && a.lights[0]
+                        .direction
+                        .abs_diff_eq(b.lights[0].direction, 1e-4),
                 "{} light at {t}",
                 s.name
             );

@@ -616,7 +616,7 @@ fn sane(
     {
         return Some("a texture whose size does not match its pixels".into());
     }
-    let l = &state.light;
+    let l = &state.lights[0];
     let c = &state.camera;
     if !(l.position.is_finite()
         && l.direction.is_finite()

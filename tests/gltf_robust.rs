@@ -353,7 +353,7 @@ fn a_huge_scene_renders_finite_with_the_default_light_and_camera() {
             .remove("NORMAL");
     }
     let scene = load(&dir, &doc).unwrap();
-    assert!(scene.light.intensity.is_finite());
+    assert!(scene.lights[0].intensity.is_finite());
     let settings = isr::settings::RenderSettings {
         width: 64,
         height: 64,

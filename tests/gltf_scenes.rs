@@ -48,7 +48,7 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
         v
     };
     assert_eq!(albedos(&file), albedos(&builtin));
-    let (l, m) = (file.light, builtin.light);
+    let (l, m) = (file.lights[0], builtin.lights[0]);
     assert!(l.position.abs_diff_eq(m.position, 1e-6) && l.direction.abs_diff_eq(m.direction, 1e-6));
     assert_eq!(
         (l.intensity, l.inner_cone, l.outer_cone, l.color),
@@ -65,7 +65,7 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
     // The light's sweep: the same animation, and at 0 s the light is at rest.
     assert_eq!(file.animation_duration(), builtin.animation_duration());
     assert!(builtin.animation_duration().is_some());
-    let rest = builtin.state_at(0.0).light;
+    let rest = builtin.state_at(0.0).lights[0];
     assert!(
         rest.position.abs_diff_eq(m.position, 1e-6)
             && rest.direction.abs_diff_eq(m.direction, 1e-6)
@@ -73,11 +73,13 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
     for t in [-1.0, 0.0, 0.4, 1.0, 1.7, 2.5, 3.0, 3.9, 4.0, 7.0] {
         let (a, b) = (file.state_at(t), builtin.state_at(t));
         assert!(
-            a.light.position.abs_diff_eq(b.light.position, 1e-6)
-                && a.light.direction.abs_diff_eq(b.light.direction, 1e-6),
+            a.lights[0].position.abs_diff_eq(b.lights[0].position, 1e-6)
+                && a.lights[0]
+                    .direction
+                    .abs_diff_eq(b.lights[0].direction, 1e-6),
             "light at {t} s: {:?} vs {:?}",
-            a.light,
-            b.light
+            a.lights[0],
+            b.lights[0]
         );
         assert!(a
             .camera
@@ -85,7 +87,7 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
             .abs_diff_eq(b.camera.world_from_camera, 1e-5));
     }
     assert!(
-        builtin.state_at(1.0).light.direction.x > 0.5,
+        builtin.state_at(1.0).lights[0].direction.x > 0.5,
         "the light sweeps"
     );
 }
@@ -139,14 +141,14 @@ fn missing_camera_and_light_get_defaults_with_warnings() {
     assert!(scene
         .warnings
         .iter()
-        .any(|w| w.contains("no KHR_lights_punctual spot light")));
+        .any(|w| w.contains("no KHR_lights_punctual light")));
     assert!(scene
         .warnings
         .iter()
         .any(|w| w.contains("no perspective camera")));
     // The default light hangs inside the bounds pointing down.
-    assert!(scene.light.direction.abs_diff_eq(-Vec3::Y, 1e-6));
-    assert!(scene.light.position.y < 2.0 && scene.light.position.y > 1.5);
+    assert!(scene.lights[0].direction.abs_diff_eq(-Vec3::Y, 1e-6));
+    assert!(scene.lights[0].position.y < 2.0 && scene.lights[0].position.y > 1.5);
 }
 
 #[test]

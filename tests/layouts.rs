@@ -93,7 +93,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", light_cone: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", cube_view_proj: 384, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -102,6 +102,8 @@ fn frame_uniforms_match_shared_glsl() {
             light_direction => "light_direction",
             light_intensity => "light_intensity",
             light_cone => "light_cone",
+            light_kind => "light_kind",
+            cube_view_proj => "cube_view_proj",
         ]);
     }
 }
@@ -208,6 +210,9 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("PRESENT_VIEW_FINAL"), PRESENT_VIEW_FINAL as u32);
     assert_eq!(value("PRESENT_VIEW_INDIRECT"), PRESENT_VIEW_INDIRECT as u32);
     assert_eq!(value("PRESENT_VIEW_HOST"), PRESENT_VIEW_HOST as u32);
+    assert_eq!(value("LIGHT_SPOT"), LIGHT_SPOT as u32);
+    assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
+    assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {
         let line = glsl
             .lines()

@@ -186,8 +186,8 @@ fn isr_chosen_patches_partition_the_rsm_flux() {
 fn no_nan_or_inf_in_degenerate_configurations() {
     let gpu = gpu();
     let mut touching = cornell_box();
-    touching.light.position = Vec3::new(0.0, 1.0, -1.0); // on the back wall
-    touching.light.direction = Vec3::Z;
+    touching.lights[0].position = Vec3::new(0.0, 1.0, -1.0); // on the back wall
+    touching.lights[0].direction = Vec3::Z;
     let mut inside = cornell_box();
     inside.camera = Camera::look_at(
         Vec3::new(-0.35, 0.6, -0.3),
@@ -197,8 +197,8 @@ fn no_nan_or_inf_in_degenerate_configurations() {
         0.01,
     );
     let mut grazing = cornell_box();
-    grazing.light.position = Vec3::new(0.0, 1e-4, 0.9); // just above the floor
-    grazing.light.direction = Vec3::new(0.0, 0.0, -1.0);
+    grazing.lights[0].position = Vec3::new(0.0, 1e-4, 0.9); // just above the floor
+    grazing.lights[0].direction = Vec3::new(0.0, 0.0, -1.0);
     for (name, scene) in [
         ("light on a wall", touching),
         ("camera inside a block", inside),

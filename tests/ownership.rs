@@ -47,12 +47,34 @@ fn a_renderer_failing_at_any_pipeline_frees_everything_it_made() {
         },
         ..Default::default()
     };
-    let scene = cornell_box();
+    // The built-in spot, and a point light with a directional one: the cube
+    // RSM (`rsm-cube`) and `light-sum` make pipelines and images of their own.
+    let spot = cornell_box();
+    let mut several = cornell_box();
+    let base = several.lights[0];
+    several.lights = vec![
+        isr::scene::Light {
+            kind: isr::scene::LightKind::Point,
+            position: glam::Vec3::new(0.3, 1.3, 0.2),
+            ..base
+        },
+        isr::scene::Light {
+            kind: isr::scene::LightKind::Directional,
+            direction: glam::Vec3::new(0.4, -1.0, -0.3).normalize(),
+            ..base
+        },
+    ];
+    for scene in [spot, several] {
+        made_pipelines_fail_in_turn(&scene, &settings);
+    }
+}
+
+fn made_pipelines_fail_in_turn(scene: &isr::scene::Scene, settings: &RenderSettings) {
     let mut failures = 0;
-    for n in 0..16 {
+    for n in 0..18 {
         let gpu = validating_gpu();
         fail_pipeline_creation_after(Some(n));
-        let failed = match Renderer::new(&gpu, &scene, &settings) {
+        let failed = match Renderer::new(&gpu, scene, settings) {
             Err(e) => Some(format!("{e:#}")),
             // Past the last pipeline: setup succeeds and is dropped normally.
             Ok(_) => None,

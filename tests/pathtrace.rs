@@ -23,8 +23,37 @@ fn pt(scene: &Scene, width: u32, height: u32, spp: u32, seed: u64) -> isr::readb
 
 #[test]
 fn direct_layer_matches_the_rasterised_direct_layer() {
+    compare_direct_layers(&cornell_box());
+}
+
+#[test]
+fn direct_layers_match_for_a_point_and_a_directional_light_together() {
+    let mut scene = cornell_box();
+    scene.animation = None;
+    let base = scene.lights[0];
+    scene.lights = vec![
+        isr::scene::Light {
+            kind: isr::scene::LightKind::Point,
+            position: Vec3::new(0.3, 1.3, 0.2),
+            intensity: 2.0,
+            ..base
+        },
+        isr::scene::Light {
+            kind: isr::scene::LightKind::Directional,
+            // Through the ceiling, which faces away from it: neither renderer
+            // lets a face turned away from a light cast a shadow.
+            direction: Vec3::new(0.4, -1.0, -0.3).normalize(),
+            intensity: 1.5,
+            ..base
+        },
+    ];
+    compare_direct_layers(&scene);
+}
+
+/// The path tracer's direct layer against the rasterizer's (RSM 1024).
+fn compare_direct_layers(scene: &Scene) {
     let gpu = gpu();
-    let scene = cornell_box();
+    let scene = scene.clone();
     let (w, h) = (128, 128);
     let raster = render(
         &gpu,

@@ -171,7 +171,7 @@ fn rsm_quadtree_matches_an_independent_cpu_reduction() {
     };
     let m = render_multires(&gpu, &scene, &settings).multires;
     let lt = &settings.light_tree;
-    let light = scene.light.position.as_dvec3();
+    let light = scene.lights[0].position.as_dvec3();
     let cos_normal = (lt.normal_threshold_deg as f64).to_radians().cos();
     let v = |a: &[f32; 4]| glam::DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     let [pos, nrm, flux] = &m.rsm_tree[0];

@@ -15,7 +15,7 @@
 use crate::scene::animation::{
     rotation_looking_along, Animation, Channel, Interpolation, Local, Parent, Property, Trs,
 };
-use crate::scene::{cornell, cuboid, Camera, Scene, SpotLight};
+use crate::scene::{cornell, cuboid, Camera, LightKind, Scene, SpotLight};
 use glam::{Mat4, Vec3, Vec4};
 
 /// A bench scene: its name, what it stresses, and the animation window the
@@ -117,6 +117,7 @@ fn path(a: &mut Animation, keys: &[(f32, Vec3, Vec3)]) -> usize {
 
 fn spot(position: Vec3, target: Vec3, intensity: f32, outer_deg: f32) -> SpotLight {
     SpotLight {
+        kind: LightKind::Spot,
         position,
         direction: (target - position).normalize(),
         color: Vec3::ONE,
@@ -222,7 +223,7 @@ pub fn fine() -> Scene {
             (4.0, Vec3::new(1.0, 2.8, 1.6), Vec3::new(1.0, 0.5, 0.4)),
         ],
     );
-    a.attach_light(node);
+    a.attach_light(0, node);
     s.animation = Some(a);
     s
 }
@@ -265,7 +266,7 @@ pub fn hall() -> Scene {
             (4.0, Vec3::new(10.0, 14.0, 8.0), Vec3::new(4.0, 0.0, -6.0)),
         ],
     );
-    a.attach_light(l);
+    a.attach_light(0, l);
     let c = path(
         &mut a,
         &[
@@ -327,7 +328,7 @@ pub fn slats() -> Scene {
             (4.0, Vec3::new(1.6, 1.2, 0.9), Vec3::new(0.0, 1.0, -1.0)),
         ],
     );
-    a.attach_light(node);
+    a.attach_light(0, node);
     s.animation = Some(a);
     s
 }

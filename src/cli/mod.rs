@@ -403,13 +403,17 @@ fn render(args: RenderArgs) -> Result<()> {
         let state = args.state_at(&scene, args.time);
         let mut posed = scene.clone();
         posed.camera = state.camera;
-        posed.light = state.light;
+        posed.lights = state.lights;
         for (inst, m) in posed.instances.iter_mut().zip(&state.instance_transforms) {
             inst.world_from_object = *m;
         }
         return pathtrace(&args, &posed);
     }
-    if scene.light.outer_cone > crate::view::MAX_RSM_HALF_FOV {
+    if scene
+        .lights
+        .iter()
+        .any(|l| l.kind == scene::LightKind::Spot && l.outer_cone > crate::view::MAX_RSM_HALF_FOV)
+    {
         eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");
     }
     let gpu = Gpu::new(&GpuOptions {

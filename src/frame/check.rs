@@ -30,16 +30,7 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         );
     }
     let needed = memory_estimate(s);
-    let props = unsafe {
-        gpu.instance
-            .get_physical_device_memory_properties(gpu.physical)
-    };
-    let heap = props.memory_heaps[..props.memory_heap_count as usize]
-        .iter()
-        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
-        .map(|h| h.size)
-        .max()
-        .unwrap_or(0);
+    let heap = device_local_heap(gpu);
     if heap > 0 && needed > heap / 10 * 9 {
         bail!(
             "resolution {}x{} with --rsm {r} needs about {} MiB of GPU memory; the device has {} MiB. Choose a smaller resolution",
@@ -50,6 +41,89 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The largest device-local heap, in bytes (0 if none is reported).
+fn device_local_heap(gpu: &Gpu) -> u64 {
+    let props = unsafe {
+        gpu.instance
+            .get_physical_device_memory_properties(gpu.physical)
+    };
+    props.memory_heaps[..props.memory_heap_count as usize]
+        .iter()
+        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+        .unwrap_or(0)
+}
+
+/// Light views (RSMs) a frame may render: a point light takes six. Each view
+/// is a sequence of passes in the frame (and a timing scope each).
+pub const MAX_LIGHT_VIEWS: usize = 64;
+
+/// Checks the scene's lights before anything is allocated: their number,
+/// and the memory they add (`light_memory_estimate`) on top of the run's.
+pub fn check_light_views(
+    gpu: &Gpu,
+    s: &RenderSettings,
+    lights: &[crate::scene::Light],
+    views: usize,
+    instances: usize,
+) -> Result<()> {
+    if lights.is_empty() {
+        bail!("the scene has no light to render");
+    }
+    if views > MAX_LIGHT_VIEWS {
+        bail!(
+            "the scene's {} lights need {views} RSMs (a point light takes six, one per cube face); isr renders at most {MAX_LIGHT_VIEWS} per frame: remove lights",
+            lights.len()
+        );
+    }
+    let cube = lights
+        .iter()
+        .any(|l| l.kind == crate::scene::LightKind::Point);
+    let extra = light_memory_estimate(s, views, instances, cube);
+    let needed = memory_estimate(s) + extra;
+    let heap = device_local_heap(gpu);
+    if heap > 0 && needed > heap / 10 * 9 {
+        bail!(
+            "the scene's {} lights ({views} RSMs) need about {} MiB of GPU memory besides the {} MiB of the run; the device has {} MiB. Remove lights or choose a smaller resolution",
+            lights.len(),
+            extra >> 20,
+            memory_estimate(s) >> 20,
+            heap >> 20
+        );
+    }
+    Ok(())
+}
+
+/// Bytes that lights add to `memory_estimate`. The views of a frame run one
+/// after another and reuse the one RSM, its quadtree and the method's
+/// buffers; what grows with them is a frame set per view and frame in flight
+/// (uniforms and instance transforms, host-visible), with more than one view
+/// the two full-resolution sums of `light-sum`, and with point lights (`cube`)
+/// the six-layer cube RSM they share.
+pub fn light_memory_estimate(
+    s: &RenderSettings,
+    views: usize,
+    instances: usize,
+    cube: bool,
+) -> u64 {
+    let frame_set = std::mem::size_of::<crate::gpu_types::FrameUniforms>() as u64
+        + instances.max(1) as u64
+            * std::mem::size_of::<crate::gpu_types::InstanceTransform>() as u64;
+    let sets = views as u64 * super::FRAMES_IN_FLIGHT as u64 * frame_set;
+    let sums = if views > 1 {
+        2 * s.width as u64 * s.height as u64 * texel_bytes(super::targets::HDR_FORMAT)
+    } else {
+        0
+    };
+    let cube = if cube {
+        crate::passes::rsm_cube::cube_bytes(s.rsm_resolution)
+    } else {
+        0
+    };
+    sets + sums + cube
 }
 
 /// Bytes of GPU memory the targets, readback buffers and the method's

@@ -22,6 +22,10 @@ use anyhow::Result;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+/// Frames recorded and submitted ahead of the one being waited for (each
+/// has its own frame sets).
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
 /// What a pass is made from.
 pub struct Setup<'a> {
     pub gpu: &'a Gpu,

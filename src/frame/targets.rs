@@ -44,8 +44,19 @@ const COLOR_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
 const DEPTH_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
     vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
 );
-/// RSM images carry the RSM quadtree in their mip chain (level 0 = the RSM).
-const RSM_USAGE: vk::ImageUsageFlags =
+/// The RSM depth also receives a point light's cube face by copy (`rsm-face`).
+const RSM_DEPTH_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
+    DEPTH_USAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_DST.as_raw(),
+);
+/// RSM images carry the RSM quadtree in their mip chain (level 0 = the RSM);
+/// a point light's cube faces are copied into level 0 (`rsm-face`).
+const RSM_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
+    COLOR_USAGE.as_raw()
+        | vk::ImageUsageFlags::STORAGE.as_raw()
+        | vk::ImageUsageFlags::TRANSFER_DST.as_raw(),
+);
+/// `light-sum` adds light views' direct images in a compute shader.
+const DIRECT_USAGE: vk::ImageUsageFlags =
     vk::ImageUsageFlags::from_raw(COLOR_USAGE.as_raw() | vk::ImageUsageFlags::STORAGE.as_raw());
 /// Methods clear, blend into, or write `indirect` from compute.
 const INDIRECT_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
@@ -75,12 +86,12 @@ pub fn target_list() -> [TargetDesc; 12] {
         t("rsm_position", RSM_FORMATS[0], true, RSM_USAGE),
         t("rsm_normal", RSM_FORMATS[1], true, RSM_USAGE),
         t("rsm_flux", RSM_FORMATS[2], true, RSM_USAGE),
-        t("rsm_depth", DEPTH_FORMAT, true, DEPTH_USAGE),
+        t("rsm_depth", DEPTH_FORMAT, true, RSM_DEPTH_USAGE),
         t("gbuffer_position", GBUFFER_FORMATS[0], false, COLOR_USAGE),
         t("gbuffer_normal", GBUFFER_FORMATS[1], false, COLOR_USAGE),
         t("gbuffer_albedo", GBUFFER_FORMATS[2], false, COLOR_USAGE),
         t("gbuffer_depth", DEPTH_FORMAT, false, DEPTH_USAGE),
-        t("direct", HDR_FORMAT, false, COLOR_USAGE),
+        t("direct", HDR_FORMAT, false, DIRECT_USAGE),
         t("indirect", HDR_FORMAT, false, INDIRECT_USAGE),
         t("final", HDR_FORMAT, false, COLOR_USAGE),
         t("display", DISPLAY_FORMAT, false, COLOR_USAGE),

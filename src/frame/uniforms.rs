@@ -3,26 +3,38 @@
 //! `shaders/shared.glsl` lays them out.
 
 use crate::gpu_types::{self, FrameUniforms, InstanceTransform, RunUniforms};
-use crate::scene::FrameState;
+use crate::scene::{FrameState, LightKind};
 use crate::settings::{RenderSettings, Upsample, VplSampling};
-use crate::view;
+use crate::view::{self, LightView};
 
-/// What the shaders need of `state` for an image of `s.width` x `s.height`.
-/// `scene_extent` (the diagonal of the scene's bounds) places the RSM's near plane.
-pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, scene_extent: f32) -> FrameUniforms {
+/// What the shaders need of `state` for an image of `s.width` x `s.height`,
+/// seen from the light RSM `v` (one of `view::light_views` of `state`'s light
+/// `v.light`).
+pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, v: &LightView) -> FrameUniforms {
     let cam = &state.camera;
-    let l = &state.light;
+    let l = &state.lights[v.light];
     let (scale, offset) = l.cone_scale_offset();
     let intensity = l.color * l.intensity;
+    let kind = match v.kind {
+        LightKind::Spot => gpu_types::LIGHT_SPOT,
+        LightKind::Point => gpu_types::LIGHT_POINT,
+        LightKind::Directional => gpu_types::LIGHT_DIRECTIONAL,
+    };
+    let range = match (v.kind, l.range) {
+        (LightKind::Directional, _) | (_, None) => 0.0,
+        (_, Some(r)) => r,
+    };
     FrameUniforms {
         camera_view_proj: view::camera_view_proj(cam, s.width, s.height).to_cols_array_2d(),
-        light_view_proj: view::light_view_proj(l, scene_extent).to_cols_array_2d(),
+        light_view_proj: v.view_proj.to_cols_array_2d(),
         camera_position: cam.position().extend(1.0).to_array(),
         camera_forward: cam.forward().extend(0.0).to_array(),
-        light_position: l.position.extend(l.range.unwrap_or(0.0)).to_array(),
-        light_direction: l.direction.extend(0.0).to_array(),
+        light_position: v.position.extend(range).to_array(),
+        light_direction: v.direction.extend(0.0).to_array(),
         light_intensity: intensity.extend(intensity.max_element()).to_array(),
-        light_cone: [scale, offset, view::rsm_half_fov(l).tan(), 0.0],
+        light_cone: [scale, offset, v.half_extent, v.depth_range],
+        light_kind: [kind, v.face.unwrap_or(0) as i32, v.light as i32, 0],
+        cube_view_proj: v.cube.map(|m| m.to_cols_array_2d()),
     }
 }
 

@@ -20,11 +20,13 @@
 pub mod composite;
 pub mod direct_light;
 pub mod gbuffer;
+pub mod light_sum;
 pub mod rsm;
+pub mod rsm_cube;
 pub mod rsm_tree;
 pub mod tonemap;
 
-use crate::frame::{FrameContext, Setup, Targets};
+use crate::frame::{FrameContext, SceneGpu, Setup, Targets};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, PassPipeline, Pipeline};
 use crate::vk::profiler::{PassKind, Profiler};
@@ -238,42 +240,8 @@ impl ScenePass {
                 cmd,
                 &Attachments::simple(&views, Some(depth.view), depth.extent),
             );
-            let d = &gpu.device;
-            unsafe {
-                self.pipeline.bind(
-                    gpu,
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    &[ctx.frame_set, scene.set.set],
-                );
-                d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-                d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
-                for draw in &scene.draws {
-                    let cull = if draw.double_sided {
-                        vk::CullModeFlags::NONE
-                    } else {
-                        vk::CullModeFlags::BACK
-                    };
-                    d.cmd_set_cull_mode(cmd, cull);
-                    d.cmd_set_front_face(cmd, crate::vk::pipeline::FRONT_FACE);
-                    d.cmd_push_constants(
-                        cmd,
-                        self.pipeline.layout,
-                        vk::ShaderStageFlags::ALL_GRAPHICS,
-                        0,
-                        bytemuck::bytes_of(&draw.push),
-                    );
-                    d.cmd_draw_indexed(
-                        cmd,
-                        draw.index_count,
-                        1,
-                        draw.first_index,
-                        draw.vertex_offset,
-                        0,
-                    );
-                }
-                d.cmd_end_rendering(cmd);
-            }
+            draw_scene(ctx, &self.pipeline, scene, 1);
+            unsafe { gpu.device.cmd_end_rendering(cmd) };
             let mut after: Vec<_> = colors
                 .iter()
                 .map(|c| barrier::image(c, Use::COLOR_ATTACHMENT, Use::READ_ONLY))
@@ -281,6 +249,47 @@ impl ScenePass {
             after.push(barrier::image(depth, Use::DEPTH_ATTACHMENT, Use::READ_ONLY));
             barrier::images(gpu, cmd, &after);
         });
+    }
+}
+
+/// Binds `pipeline` (set 0 the frame set, set 1 the scene's) and draws every
+/// mesh instance `instances` times (a layered draw: one instance per layer).
+pub fn draw_scene(ctx: &FrameContext, pipeline: &Pipeline, scene: &SceneGpu, instances: u32) {
+    let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+    let d = &gpu.device;
+    unsafe {
+        pipeline.bind(
+            gpu,
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            &[ctx.frame_set, scene.set.set],
+        );
+        d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+        d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+        for draw in &scene.draws {
+            let cull = if draw.double_sided {
+                vk::CullModeFlags::NONE
+            } else {
+                vk::CullModeFlags::BACK
+            };
+            d.cmd_set_cull_mode(cmd, cull);
+            d.cmd_set_front_face(cmd, crate::vk::pipeline::FRONT_FACE);
+            d.cmd_push_constants(
+                cmd,
+                pipeline.layout,
+                vk::ShaderStageFlags::ALL_GRAPHICS,
+                0,
+                bytemuck::bytes_of(&draw.push),
+            );
+            d.cmd_draw_indexed(
+                cmd,
+                draw.index_count,
+                instances,
+                draw.first_index,
+                draw.vertex_offset,
+                0,
+            );
+        }
     }
 }
 

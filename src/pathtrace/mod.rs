@@ -1,11 +1,13 @@
 //! Method `pathtrace` (docs/algorithm.md sections 1 and 5): a one-bounce diffuse
 //! reference WITH indirect visibility, on the CPU (all cores, rayon), from the
-//! same spot light, camera and materials as the rasterizer. It shows the error
+//! same lights (every light of the scene: spot, point, directional), camera
+//! and materials as the rasterizer. It shows the error
 //! that ignoring indirect visibility causes, which every VPL method shares.
 //!
 //! Per pixel, the primary ray goes through the pixel centre (as the G-buffer
 //! samples it), so the direct layer is noise-free:
-//!   L_direct(x) = rho/pi * I(w) * max(0, n.l) / r^2 * V     (shadow ray, exact V)
+//!   L_direct(x) = sum over lights of rho/pi * I(w) * max(0, n.l) / r^2 * V
+//!   (spot, point; directional: rho/pi * E * max(0, n.l) * V; exact V by a shadow ray)
 //! Indirect irradiance by cosine-weighted hemisphere sampling, `spp` rays:
 //!   E(x) = integral of L_direct(y(w)) cos dw ~= pi / N * sum_k L_direct(y_k)
 //! where y_k is the nearest surface along sample k (occlusion included). The
@@ -14,7 +16,7 @@
 pub mod bvh;
 
 use crate::readback::{Readback, RsmReadback};
-use crate::scene::{Scene, SpotLight};
+use crate::scene::{Light, LightKind, Scene};
 use bvh::{Bvh, Cull, Triangle};
 use glam::{Mat4, Vec2, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -25,7 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 struct Shading<'a> {
     scene: &'a Scene,
     bvh: Bvh,
-    light: SpotLight,
+    lights: Vec<Light>,
     /// Ray offset off surfaces, relative to the scene size.
     epsilon: f32,
 }
@@ -103,7 +105,7 @@ impl Shading<'_> {
         Shading {
             scene,
             bvh: Bvh::new(triangles),
-            light: scene.light,
+            lights: scene.lights.clone(),
             epsilon: size * 1e-5,
         }
     }
@@ -162,20 +164,37 @@ impl Shading<'_> {
         })
     }
 
-    /// Radiance leaving `s` (Lambertian) from the spot light, shadow ray included.
+    /// Radiance leaving `s` (Lambertian) from every light, shadow rays included.
     fn direct(&self, s: &SurfacePoint) -> Vec3 {
-        let to_light = Vec3A::from(self.light.position) - s.position;
-        let r2 = to_light.length_squared();
-        let r = r2.sqrt();
-        let l = to_light / r;
+        self.lights.iter().map(|l| self.direct_from(l, s)).sum()
+    }
+
+    /// Radiance leaving `s` from `light`: a shadow ray to the light's
+    /// position, or toward a directional light without end.
+    fn direct_from(&self, light: &Light, s: &SurfacePoint) -> Vec3 {
+        let (l, r, r2) = if light.kind == LightKind::Directional {
+            (
+                -Vec3A::from(light.direction).normalize(),
+                f32::INFINITY,
+                1.0,
+            )
+        } else {
+            let to_light = Vec3A::from(light.position) - s.position;
+            let r2 = to_light.length_squared();
+            let r = r2.sqrt();
+            (to_light / r, r, r2)
+        };
         let cos = s.normal.dot(l);
-        if cos <= 0.0 || r2 == 0.0 {
+        if cos <= 0.0 || r2 == 0.0 || !cos.is_finite() {
             return Vec3::ZERO;
         }
-        let intensity = self
-            .light
-            .intensity_toward(Vec3::from(s.position).as_dvec3())
-            .as_vec3();
+        let at = Vec3::from(s.position).as_dvec3();
+        // W/sr for spot and point lights, E (W/m^2) for directional ones (r2 = 1).
+        let intensity = if light.kind == LightKind::Directional {
+            light.irradiance_facing(at).as_vec3()
+        } else {
+            light.intensity_toward(at).as_vec3()
+        };
         if intensity.max_element() <= 0.0 {
             return Vec3::ZERO;
         }

@@ -22,6 +22,7 @@ const SWEEP_TILT_DEG: f32 = 40.0;
 
 pub fn cornell_box() -> Scene {
     let light = SpotLight {
+        kind: crate::scene::LightKind::Spot,
         position: Vec3::new(0.0, 1.9, 0.0),
         direction: Vec3::new(0.0, -1.0, -0.15).normalize(),
         color: Vec3::ONE,
@@ -112,7 +113,7 @@ fn light_sweep(light: &SpotLight) -> Animation {
     let node = a
         .add_node(Parent::Fixed(Mat4::IDENTITY), Local::Animated(rest))
         .expect(built_in);
-    a.attach_light(node);
+    a.attach_light(0, node);
     let channel = Channel::new(
         node,
         Property::Rotation,

@@ -100,13 +100,12 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
         .collect();
     let mut roots: Vec<usize> = (0..nodes.len()).collect();
     let mut animations = vec![];
-    let (mut light_at, mut camera_at) = (None, None);
+    let (mut light_at, mut camera_at) = (vec![], None);
     if let Some(a) = &scene.animation {
         let (anim, l, c) = animation_json(a, &mut nodes, &mut roots, &mut bin);
         animations.push(anim);
         (light_at, camera_at) = (l, c);
     }
-    let l = &scene.light;
     let mut place = |at: Option<usize>, fields: Value, matrix: Mat4| match at {
         // On the animated node that moves it.
         Some(id) => {
@@ -121,25 +120,41 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
             roots.push(nodes.len() - 1);
         }
     };
-    place(
-        light_at,
-        json!({"name": "light", "extensions": {"KHR_lights_punctual": {"light": 0}}}),
-        looking_along(l.position, l.direction),
-    );
+    for (i, l) in scene.lights.iter().enumerate() {
+        let at = light_at
+            .iter()
+            .find(|&&(light, _)| light == i)
+            .map(|&(_, n)| n);
+        place(
+            at,
+            json!({"name": format!("light {i}"), "extensions": {"KHR_lights_punctual": {"light": i}}}),
+            looking_along(l.position, l.direction),
+        );
+    }
     place(
         camera_at,
         json!({"name": "camera", "camera": 0}),
         scene.camera.world_from_camera,
     );
-    let mut light = json!({"type": "spot", "color": l.color.to_array(), "intensity": l.intensity,
-        "spot": {"innerConeAngle": l.inner_cone, "outerConeAngle": l.outer_cone}});
-    if let Some(r) = l.range {
-        light["range"] = json!(r);
-    }
+    let lights: Vec<Value> = scene
+        .lights
+        .iter()
+        .map(|l| {
+            let mut light = json!({"type": l.kind.name(), "color": l.color.to_array(), "intensity": l.intensity});
+            if l.kind == crate::scene::LightKind::Spot {
+                light["spot"] =
+                    json!({"innerConeAngle": l.inner_cone, "outerConeAngle": l.outer_cone});
+            }
+            if let (Some(r), false) = (l.range, l.kind == crate::scene::LightKind::Directional) {
+                light["range"] = json!(r);
+            }
+            light
+        })
+        .collect();
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "isr export-builtin"},
         "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [light]}},
+        "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "scene": 0,
         "scenes": [{"name": scene.name, "nodes": roots}],
         "nodes": nodes,
@@ -160,14 +175,14 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
 /// Writes the animation's nodes (TRS where animated) and one glTF animation
 /// with a sampler per channel. Instances the animation moves become children
 /// without a transform of their node (`nodes[i]` is instance `i` on entry).
-/// Returns the animation and the nodes that carry the light and the camera
-/// when it moves them.
+/// Returns the animation and the nodes that carry lights (light index, node)
+/// and the camera when it moves them.
 fn animation_json(
     a: &Animation,
     nodes: &mut Vec<Value>,
     roots: &mut Vec<usize>,
     bin: &mut Bin,
-) -> (Value, Option<usize>, Option<usize>) {
+) -> (Value, Vec<(usize, usize)>, Option<usize>) {
     let instances = nodes.len();
     let mut ids = Vec::with_capacity(a.nodes.len());
     let mut children: Vec<(usize, usize)> = vec![];
@@ -228,5 +243,6 @@ fn animation_json(
             "target": {"node": ids[c.node], "path": c.property.name()}}));
     }
     let anim = json!({"name": "animation", "samplers": samplers, "channels": channels});
-    (anim, a.light.map(|n| ids[n]), a.camera.map(|n| ids[n]))
+    let lights = a.lights.iter().map(|&(l, n)| (l, ids[n])).collect();
+    (anim, lights, a.camera.map(|n| ids[n]))
 }

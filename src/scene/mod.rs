@@ -1,5 +1,5 @@
-//! Scenes: triangle meshes placed by transforms, diffuse materials, one spot
-//! light and one perspective camera. Loaded from glTF (`gltf_load`), built in
+//! Scenes: triangle meshes placed by transforms, diffuse materials, a list
+//! of lights (spot, point, directional) and one perspective camera. Loaded from glTF (`gltf_load`), built in
 //! (`cornell`), or assembled by code (tests) with the helpers below.
 
 mod accessor;
@@ -82,26 +82,59 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
-/// A `KHR_lights_punctual` spot light (docs/algorithm.md section 2).
+/// What kind of `KHR_lights_punctual` light (docs/algorithm.md section 2.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightKind {
+    /// A cone: intensity in candela (W/sr), the cones below apply.
+    #[default]
+    Spot,
+    /// All around: intensity in candela (W/sr); the cones are ignored.
+    Point,
+    /// Parallel rays along `direction`: intensity in lux, read as the
+    /// irradiance E (W/m^2) on a surface facing the light; position, cones
+    /// and range are ignored.
+    Directional,
+}
+
+impl LightKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LightKind::Spot => "spot",
+            LightKind::Point => "point",
+            LightKind::Directional => "directional",
+        }
+    }
+}
+
+/// A `KHR_lights_punctual` light (docs/algorithm.md sections 2.3 and 2.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SpotLight {
+pub struct Light {
+    pub kind: LightKind,
     pub position: Vec3,
-    /// Unit vector the cone points along (the node's -Z).
+    /// Unit vector the cone (or the directional light's rays) points along (the node's -Z).
     pub direction: Vec3,
     /// Linear RGB color.
     pub color: Vec3,
-    /// Luminous intensity in candela, treated as W/sr.
+    /// Spot and point: luminous intensity in candela, treated as W/sr.
+    /// Directional: illuminance in lux, treated as irradiance E in W/m^2.
     pub intensity: f32,
-    /// Radians; attenuation is smooth between inner and outer.
+    /// Radians; attenuation is smooth between inner and outer (spot lights only).
     pub inner_cone: f32,
     pub outer_cone: f32,
     /// Distance cut-off; `None` means none (the extension's default).
     pub range: Option<f32>,
 }
 
-impl SpotLight {
-    /// The extension's angular attenuation, squared smoothstep between the cones.
+/// The name most of the code knew the light by, when spot lights were all there was.
+pub type SpotLight = Light;
+
+impl Light {
+    /// The extension's angular attenuation, squared smoothstep between the
+    /// cones; 1 for point and directional lights.
     pub fn angular_attenuation(&self, cos_angle: f64) -> f64 {
+        if self.kind != LightKind::Spot {
+            return 1.0;
+        }
         let (scale, offset) = self.cone_scale_offset();
         let t = (cos_angle * scale as f64 + offset as f64).clamp(0.0, 1.0);
         t * t
@@ -116,7 +149,7 @@ impl SpotLight {
     }
 
     /// Radiant intensity (W/sr) toward world point `p`, per color channel,
-    /// including the range window when a range is set.
+    /// including the range window when a range is set. Spot and point lights.
     pub fn intensity_toward(&self, p: glam::DVec3) -> glam::DVec3 {
         let to = p - self.position.as_dvec3();
         let d = to.length();
@@ -127,6 +160,24 @@ impl SpotLight {
             i *= (1.0 - r.powi(4)).clamp(0.0, 1.0);
         }
         i
+    }
+
+    /// Irradiance (W/m^2, per channel) on a surface at `p` facing the light,
+    /// unshadowed: `I(w) / d^2` for spot and point lights, `E` for directional
+    /// ones (docs/algorithm.md section 2.4).
+    pub fn irradiance_facing(&self, p: glam::DVec3) -> glam::DVec3 {
+        match self.kind {
+            LightKind::Directional => self.color.as_dvec3() * self.intensity as f64,
+            _ => self.intensity_toward(p) / (p - self.position.as_dvec3()).length_squared(),
+        }
+    }
+
+    /// Unit vector from `p` toward the light.
+    pub fn direction_from(&self, p: glam::DVec3) -> glam::DVec3 {
+        match self.kind {
+            LightKind::Directional => -self.direction.as_dvec3().normalize(),
+            _ => (self.position.as_dvec3() - p).normalize(),
+        }
     }
 }
 
@@ -163,7 +214,8 @@ impl Camera {
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameState {
     pub camera: Camera,
-    pub light: SpotLight,
+    /// Every light of the scene, in `Scene::lights` order.
+    pub lights: Vec<Light>,
     /// World transform of each `Scene::instances` entry, in the same order.
     pub instance_transforms: Vec<Mat4>,
 }
@@ -175,7 +227,8 @@ pub struct Scene {
     pub instances: Vec<Instance>,
     pub materials: Vec<Material>,
     pub textures: Vec<Texture>,
-    pub light: SpotLight,
+    /// At least one light; each gets its own RSM and light tree.
+    pub lights: Vec<Light>,
     pub camera: Camera,
     /// Things the loader skipped or assumed, printed by the CLI.
     pub warnings: Vec<String>,
@@ -185,14 +238,14 @@ pub struct Scene {
 
 impl Scene {
     /// An empty scene with the given light and camera, for code that builds scenes.
-    pub fn empty(name: &str, light: SpotLight, camera: Camera) -> Self {
+    pub fn empty(name: &str, light: Light, camera: Camera) -> Self {
         Self {
             name: name.into(),
             meshes: vec![],
             instances: vec![],
             materials: vec![],
             textures: vec![],
-            light,
+            lights: vec![light],
             camera,
             warnings: vec![],
             animation: None,
@@ -256,7 +309,7 @@ impl Scene {
     pub fn rest_state(&self) -> FrameState {
         FrameState {
             camera: self.camera,
-            light: self.light,
+            lights: self.lights.clone(),
             instance_transforms: self.instances.iter().map(|i| i.world_from_object).collect(),
         }
     }
@@ -409,6 +462,7 @@ mod tests {
     #[test]
     fn spot_attenuation_follows_khr_lights_punctual() {
         let l = SpotLight {
+            kind: LightKind::Spot,
             position: Vec3::ZERO,
             direction: -Vec3::Y,
             color: Vec3::ONE,

@@ -47,14 +47,15 @@ fn turn(period: f32, t: f32) -> Option<Quat> {
         .then(|| Quat::from_rotation_y(std::f32::consts::TAU * turns))
 }
 
-/// Moves the light of `state` (its placement at t = 0) to time `t` of its
-/// orbit, aimed at its aim point.
+/// Moves the lights of `state` (their placement at t = 0) to time `t` of
+/// their orbit, each aimed at its aim point (a directional light turns).
 pub fn orbit_light(state: &mut FrameState, pivot: Vec3, period: f32, t: f32) {
     let Some(rot) = turn(period, t) else { return };
-    let l = &mut state.light;
-    let aim = aim_point(l.position, l.direction, pivot);
-    l.position = pivot + rot * (l.position - pivot);
-    l.direction = (aim - l.position).normalize_or(rot * l.direction);
+    for l in &mut state.lights {
+        let aim = aim_point(l.position, l.direction, pivot);
+        l.position = pivot + rot * (l.position - pivot);
+        l.direction = (aim - l.position).normalize_or(rot * l.direction);
+    }
 }
 
 /// Moves the camera of `state` (its placement at t = 0) to time `t` of its
@@ -81,7 +82,8 @@ mod tests {
     fn state(light_at: Vec3, light_dir: Vec3, eye: Vec3, target: Vec3) -> FrameState {
         FrameState {
             camera: Camera::look_at(eye, target, Vec3::Y, 0.7, 0.05),
-            light: SpotLight {
+            lights: vec![SpotLight {
+                kind: crate::scene::LightKind::Spot,
                 position: light_at,
                 direction: light_dir.normalize(),
                 color: Vec3::ONE,
@@ -89,7 +91,7 @@ mod tests {
                 inner_cone: 0.3,
                 outer_cone: 0.6,
                 range: None,
-            },
+            }],
             instance_transforms: vec![],
         }
     }
@@ -114,7 +116,7 @@ mod tests {
             Vec3::new(0.0, 1.0, 4.0),
             pivot,
         );
-        let l0 = s0.light;
+        let l0 = s0.lights[0];
         let aim = aim_point(l0.position, l0.direction, pivot);
         // The point of the axis nearest the pivot, by hand.
         let s = (pivot - l0.position).dot(l0.direction);
@@ -123,7 +125,7 @@ mod tests {
         for t in [0.0, 0.3, 1.0, 2.0, 3.7, 4.0, 9.0] {
             let mut st = s0.clone();
             orbit_light(&mut st, pivot, period, t);
-            let l = st.light;
+            let l = st.lights[0];
             let (r0, h0) = radius_height(l0.position, pivot);
             let (r, h) = radius_height(l.position, pivot);
             assert!((r - r0).abs() < 1e-5 && (h - h0).abs() < 1e-6, "t {t}");
@@ -144,12 +146,11 @@ mod tests {
         // A whole period comes back to the start; half a period is opposite.
         let mut st = s0.clone();
         orbit_light(&mut st, pivot, period, period);
-        assert!(st.light.position.abs_diff_eq(l0.position, 1e-5));
-        assert!(st.light.direction.abs_diff_eq(l0.direction, 1e-5));
+        assert!(st.lights[0].position.abs_diff_eq(l0.position, 1e-5));
+        assert!(st.lights[0].direction.abs_diff_eq(l0.direction, 1e-5));
         let mut st = s0.clone();
         orbit_light(&mut st, pivot, period, 0.5 * period);
-        assert!(st
-            .light
+        assert!(st.lights[0]
             .position
             .abs_diff_eq(Vec3::new(-0.5, 2.0, -0.5), 1e-5));
     }
@@ -167,8 +168,12 @@ mod tests {
         );
         let mut st = s0.clone();
         orbit_light(&mut st, pivot, 4.0, 1.0);
-        assert!(st.light.position.abs_diff_eq(s0.light.position, 1e-6));
-        assert!(st.light.direction.abs_diff_eq(s0.light.direction, 1e-6));
+        assert!(st.lights[0]
+            .position
+            .abs_diff_eq(s0.lights[0].position, 1e-6));
+        assert!(st.lights[0]
+            .direction
+            .abs_diff_eq(s0.lights[0].direction, 1e-6));
     }
 
     #[test]
@@ -199,7 +204,7 @@ mod tests {
             assert!(x.y.abs() < 1e-5 && y.y > 0.0, "t {t}: x {x}");
             assert!((x.length() - 1.0).abs() < 1e-5 && x.dot(y).abs() < 1e-5);
             assert_eq!((c.yfov, c.znear), (s0.camera.yfov, s0.camera.znear));
-            assert_eq!(st.light, s0.light);
+            assert_eq!(st.lights[0], s0.lights[0]);
         }
         let mut st = s0.clone();
         orbit_camera(&mut st, pivot, period, period);

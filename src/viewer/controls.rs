@@ -243,10 +243,12 @@ impl Controls {
     }
 
     /// `state` (the scene at the animation time) with the user's camera and
-    /// the light moved and turned by the user's offsets.
+    /// the scene's first light moved and turned by the user's offsets.
     pub fn apply(&self, state: &mut FrameState) {
         state.camera = self.camera();
-        let l = &mut state.light;
+        let Some(l) = state.lights.first_mut() else {
+            return;
+        };
         l.position += self.light_offset;
         let right = l.direction.cross(Vec3::Y).normalize_or(Vec3::X);
         let turn =

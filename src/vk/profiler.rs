@@ -49,7 +49,27 @@ pub struct Profiler {
     timestamp_mask: u64,
     ns_per_tick: f64,
     passes: Vec<(&'static str, PassKind)>,
+    /// Appended to pass names as `name[label]` while set: which light view
+    /// a pass belongs to when a frame has several.
+    label: Option<String>,
     shared: Arc<Shared>,
+}
+
+/// `name[label]` as a `&'static str`: each distinct name is leaked once and
+/// reused, so the set is bounded by passes times light views.
+fn labelled(name: &'static str, label: &str) -> &'static str {
+    use std::collections::HashSet;
+    use std::sync::Mutex;
+    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
+    let full = format!("{name}[{label}]");
+    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
+    let names = names.get_or_insert_with(HashSet::new);
+    if let Some(&n) = names.get(full.as_str()) {
+        return n;
+    }
+    let n: &'static str = Box::leak(full.into_boxed_str());
+    names.insert(n);
+    n
 }
 
 const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFlags::from_raw(
@@ -89,6 +109,7 @@ impl Profiler {
             timestamp_mask,
             ns_per_tick: gpu.properties.limits.timestamp_period as f64,
             passes: Vec::new(),
+            label: None,
             shared: gpu.shared.clone(),
         };
         if gpu.features.timestamps {
@@ -134,6 +155,11 @@ impl Profiler {
         }
     }
 
+    /// Passes recorded from now on are named `name[label]` (`None`: `name`).
+    pub fn set_label(&mut self, label: Option<String>) {
+        self.label = label;
+    }
+
     /// Records `body` as the pass `name`, surrounded by its queries and a debug
     /// label, followed by its end-of-pass timestamp.
     pub fn pass<R>(
@@ -144,6 +170,10 @@ impl Profiler {
         kind: PassKind,
         body: impl FnOnce() -> R,
     ) -> R {
+        let name = match &self.label {
+            Some(l) => labelled(name, l),
+            None => name,
+        };
         let index = self.passes.len() as u32;
         assert!(
             index < self.capacity,

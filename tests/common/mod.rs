@@ -84,6 +84,7 @@ pub fn spot(
     outer_deg: f32,
 ) -> SpotLight {
     SpotLight {
+        kind: isr::scene::LightKind::Spot,
         position,
         direction: (target - position).normalize(),
         color: Vec3::ONE,

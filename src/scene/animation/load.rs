@@ -192,9 +192,9 @@ pub fn from_gltf(
             anim.attach_camera(s);
         }
     }
-    if let Some(n) = bound.light {
+    for (i, &n) in bound.lights.iter().enumerate() {
         if let Some(s) = slot_of(n, &mut anim)? {
-            anim.attach_light(s);
+            anim.attach_light(i, s);
         }
     }
     for mut c in channels {

@@ -248,7 +248,8 @@ pub struct Animation {
     /// (index into `Scene::instances`, node).
     pub(super) instances: Vec<(usize, usize)>,
     pub(super) camera: Option<usize>,
-    pub(super) light: Option<usize>,
+    /// (index into `Scene::lights`, node).
+    pub(super) lights: Vec<(usize, usize)>,
 }
 
 impl Animation {
@@ -294,10 +295,11 @@ impl Animation {
         self.camera = Some(node);
     }
 
-    /// The light sits at `node`'s origin and points along its -Z.
-    pub fn attach_light(&mut self, node: usize) {
+    /// Light `light` (an index into `Scene::lights`) sits at `node`'s origin
+    /// and points along its -Z.
+    pub fn attach_light(&mut self, light: usize, node: usize) {
         assert!(node < self.nodes.len(), "attach to a node that exists");
-        self.light = Some(node);
+        self.lights.push((light, node));
     }
 
     /// The latest keyframe time of any channel; `None` without channels.
@@ -338,8 +340,10 @@ impl Animation {
         if let Some(n) = self.camera {
             state.camera.world_from_camera = world[n];
         }
-        if let Some(n) = self.light {
-            let l = &mut state.light;
+        for &(i, n) in &self.lights {
+            let Some(l) = state.lights.get_mut(i) else {
+                continue;
+            };
             l.position = world[n].transform_point3(Vec3::ZERO);
             // A node scaled to zero has no direction: keep the last one.
             l.direction = world[n]
@@ -369,7 +373,8 @@ pub struct NodeBindings {
     /// The node of each `Scene::instances` entry, in order.
     pub instances: Vec<usize>,
     pub camera: Option<usize>,
-    pub light: Option<usize>,
+    /// The node of each `Scene::lights` entry, in order (empty for the default light).
+    pub lights: Vec<usize>,
 }
 
 #[cfg(test)]

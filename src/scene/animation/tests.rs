@@ -204,7 +204,8 @@ fn bad_keys_are_refused() {
 fn state(instances: usize) -> FrameState {
     FrameState {
         camera: Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 0.7, 0.05),
-        light: SpotLight {
+        lights: vec![SpotLight {
+            kind: crate::scene::LightKind::Spot,
             position: Vec3::ZERO,
             direction: -Vec3::Y,
             color: Vec3::ONE,
@@ -212,7 +213,7 @@ fn state(instances: usize) -> FrameState {
             inner_cone: 0.3,
             outer_cone: 0.6,
             range: None,
-        },
+        }],
         instance_transforms: vec![Mat4::IDENTITY; instances],
     }
 }
@@ -274,7 +275,7 @@ fn nested_nodes_compose_parent_then_child() {
     .unwrap();
     a.attach_instance(1, child);
     a.attach_camera(below);
-    a.attach_light(parent);
+    a.attach_light(0, parent);
     assert_eq!(a.duration(), Some(2.0));
 
     let mut s = state(3);
@@ -304,8 +305,12 @@ fn nested_nodes_compose_parent_then_child() {
         .world_from_camera
         .abs_diff_eq(parent_m * child_m * offset, 1e-6));
     // The light at the parent's origin, pointing along its -Z.
-    assert!(s.light.position.abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6));
-    assert!(s.light.direction.abs_diff_eq(Vec3::new(-sn, 0.0, -c), 1e-6));
+    assert!(s.lights[0]
+        .position
+        .abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6));
+    assert!(s.lights[0]
+        .direction
+        .abs_diff_eq(Vec3::new(-sn, 0.0, -c), 1e-6));
 }
 
 #[test]

@@ -57,25 +57,23 @@ pub(super) fn check_znear(index: usize, node: usize, c: &Camera, lo: Vec3, hi: V
 }
 
 pub(super) fn read_light(l: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<SpotLight> {
+    use crate::scene::LightKind;
     use gltf::khr_lights_punctual::Kind;
-    let (inner, outer) = match l.kind() {
+    let (kind, inner, outer) = match l.kind() {
         Kind::Spot {
             inner_cone_angle,
             outer_cone_angle,
-        } => (inner_cone_angle, outer_cone_angle),
-        Kind::Point => bail!(
-            "light {} is a point light: not supported yet (isr renders spot lights; point and directional lights come later)",
-            l.index()
-        ),
-        Kind::Directional => bail!(
-            "light {} is a directional light: not supported yet (isr renders spot lights; point and directional lights come later)",
-            l.index()
-        ),
+        } => (LightKind::Spot, inner_cone_angle, outer_cone_angle),
+        // Cones mean nothing for these; the values are never read.
+        Kind::Point => (LightKind::Point, 0.0, std::f32::consts::FRAC_PI_2),
+        Kind::Directional => (LightKind::Directional, 0.0, std::f32::consts::FRAC_PI_2),
     };
     let half_pi = std::f32::consts::FRAC_PI_2;
-    if !((0.0..half_pi).contains(&inner) && outer > inner && outer <= half_pi) {
+    if kind == LightKind::Spot
+        && !((0.0..half_pi).contains(&inner) && outer > inner && outer <= half_pi)
+    {
         bail!(
-            "light {}: cone angles must satisfy 0 <= inner < outer <= pi/2 (got {inner}, {outer})",
+            "light {} (spot): cone angles must satisfy 0 <= inner < outer <= pi/2, i.e. the outer cone above the inner one and at most 90 degrees (got inner {inner}, outer {outer} radians)",
             l.index()
         );
     }
@@ -107,6 +105,7 @@ pub(super) fn read_light(l: &gltf::khr_lights_punctual::Light, world: Mat4) -> R
         );
     }
     Ok(SpotLight {
+        kind,
         position: world.transform_point3(Vec3::ZERO),
         direction: direction.normalize(),
         color,
@@ -136,6 +135,7 @@ pub fn fitted_light(lo: Vec3, hi: Vec3) -> SpotLight {
     let position = glam::DVec3::new(center.x, hi.y - 0.05 * size, center.z);
     let drop = (position.y - lo.y).max(0.1 * size);
     SpotLight {
+        kind: crate::scene::LightKind::Spot,
         position: position.as_vec3(),
         direction: -Vec3::Y,
         color: Vec3::ONE,

@@ -110,7 +110,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         base: &base,
         options,
     };
-    let mut light: Option<SpotLight> = None;
+    let mut lights: Vec<(usize, SpotLight)> = Vec::new();
     let mut camera: Option<(usize, usize, Camera)> = None;
     let mut bound = super::animation::NodeBindings::default();
 
@@ -165,16 +165,10 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             }
         }
         if let Some(l) = node.light() {
-            let spot = read_light(&l, world)?;
-            if light.is_none() {
-                light = Some(spot);
-                bound.light = Some(node.index());
-            } else {
-                warnings.push(format!(
-                    "light {} ignored: isr renders one light per frame (the first spot light is used)",
-                    l.index()
-                ));
-            }
+            // Every light node is a light (a light instanced by two nodes
+            // shines from both); ordered by node below, so the order is the
+            // file's and not the traversal's.
+            lights.push((node.index(), read_light(&l, world)?));
         }
         if let Some(c) = node.camera() {
             match c.projection() {
@@ -206,16 +200,18 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             limits.coordinate
         );
     }
-    match light {
-        Some(l) => out.light = l,
-        None => {
-            out.light = fitted_light(lo, hi);
-            warnings.push(format!(
-                "no KHR_lights_punctual spot light: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd)",
-                out.light.position.to_array(),
-                out.light.intensity
-            ));
-        }
+    lights.sort_by_key(|&(node, _)| node);
+    if lights.is_empty() {
+        let l = fitted_light(lo, hi);
+        warnings.push(format!(
+            "no KHR_lights_punctual light: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd)",
+            l.position.to_array(),
+            l.intensity
+        ));
+        out.lights = vec![l];
+    } else {
+        bound.lights = lights.iter().map(|&(node, _)| node).collect();
+        out.lights = lights.into_iter().map(|(_, l)| l).collect();
     }
     match camera {
         Some((index, node, c)) => {

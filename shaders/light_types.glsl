@@ -1,0 +1,154 @@
+// What differs between the light types (docs/algorithm.md section 2.4): spot,
+// one cube face of a point light, directional. Every pass that depends on the
+// type calls these small functions, so a pass's own code (and the HISR
+// traversal loop) stays the same for all types. Needs frame.glsl (`u`, `run`).
+#ifndef LIGHT_TYPES_GLSL
+#define LIGHT_TYPES_GLSL
+#include "lighting.glsl"
+
+bool light_is_directional() { return u.light_kind.x == LIGHT_DIRECTIONAL; }
+
+// Whether world point p belongs to this view's cube face: the face whose axis
+// is the largest component of p - light (ties go to x, then y, then z), so the
+// six faces partition the directions and no point is lit twice.
+bool in_cube_face(vec3 p, int face) {
+    vec3 d = p - u.light_position.xyz;
+    vec3 a = abs(d);
+    int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
+    float sign = (face & 1) == 0 ? 1.0 : -1.0;
+    return axis == face / 2 && d[axis] * sign > 0.0;
+}
+
+// Spot and point: radiant intensity toward p (W/sr, per channel), zero outside
+// the spot's cone or cube face `face` (the RSM's layer, or this view's face).
+// Directional: the irradiance E (W/m^2) on a surface facing the light.
+vec3 light_intensity_toward(vec3 p, int face) {
+    if (u.light_kind.x == LIGHT_SPOT) return spot_intensity(u, p);
+    if (light_is_directional()) return u.light_intensity.rgb;
+    if (!in_cube_face(p, face)) return vec3(0.0);
+    vec3 i = u.light_intensity.rgb;
+    if (u.light_position.w > 0.0) {
+        float r = length(p - u.light_position.xyz) / u.light_position.w;
+        i *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    }
+    return i;
+}
+
+// Unit vector from p toward the light, and the squared distance r2 that
+// divides the intensity (1 for a directional light: E needs no falloff).
+vec3 light_direction_from(vec3 p, out float r2) {
+    if (light_is_directional()) {
+        r2 = 1.0;
+        return -u.light_direction.xyz;
+    }
+    vec3 to_light = u.light_position.xyz - p;
+    r2 = dot(to_light, to_light);
+    return to_light * inversesqrt(r2);
+}
+
+// One RSM texel (docs/algorithm.md sections 2.3 and 2.4) at framebuffer
+// coordinate frag seeing point x with normal n (cos_j floored at min_cos):
+//   Phi_j = rho_j * intensity * measure; area: A_j (m^2); dw: dw_j (sr).
+// Perspective (spot, cube face): dw_j = texel^2 cos^3 alpha on the unit image
+// plane, Phi_j = rho I(w) dw_j, A_j = dw_j r^2 / cos_j. Orthographic: every
+// texel has the same area a = texel^2 perpendicular to the light,
+// Phi_j = rho E a, A_j = a / cos_j, and no solid angle (dw_j = 0).
+void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 intensity,
+               out float measure, out float area, out float dw) {
+    float res = float(run.size.z);
+    float half_extent = u.light_cone.z;
+    float texel = 2.0 * half_extent / res;
+    intensity = light_intensity_toward(x, face);
+    bool lit = max(intensity.r, max(intensity.g, intensity.b)) > 0.0;
+    if (light_is_directional()) {
+        float a = texel * texel;
+        float cos_j = max(dot(n, -u.light_direction.xyz), min_cos);
+        measure = a;
+        area = lit ? a / cos_j : 0.0;
+        dw = 0.0;
+        return;
+    }
+    // The texel center's point on the image plane at unit distance from the light.
+    vec2 plane = (frag / res * 2.0 - 1.0) * half_extent;
+    float cos_alpha = inversesqrt(1.0 + dot(plane, plane));
+    dw = texel * texel * cos_alpha * cos_alpha * cos_alpha;
+    vec3 to_light = u.light_position.xyz - x;
+    float r2 = dot(to_light, to_light);
+    float cos_j = max(dot(n, to_light * inversesqrt(r2)), min_cos);
+    measure = dw;
+    area = lit ? dw * r2 / cos_j : 0.0;
+}
+
+// Shadow lookup for receiver p (docs/algorithm.md section 2): how many metres
+// one RSM texel spans at p (for the normal offset), and the reference depth
+// for a receiver at RSM depth z tilted by tan_theta from the light. Perspective
+// reversed-Z depth is near/z, so biases are relative (d(near/z)/(near/z) =
+// -dz/z, the texel's angular size times the slope); orthographic depth is
+// linear over light_cone.w metres, so biases are lengths over that range.
+float shadow_texel_world(vec3 p) {
+    float res = float(run.size.z);
+    if (light_is_directional()) return 2.0 * u.light_cone.z / res;
+    float dist = dot(p - u.light_position.xyz, u.light_direction.xyz);
+    return 2.0 * u.light_cone.z * max(dist, 0.0) / res;
+}
+
+float shadow_reference(float z, float tan_theta, float texel_world) {
+    float res = float(run.size.z);
+    if (light_is_directional()) {
+        return z + run.shadow.y + run.shadow.w * texel_world * tan_theta / u.light_cone.w;
+    }
+    float texel_angle = 2.0 * u.light_cone.z / res;
+    return z * (1.0 + run.shadow.y + run.shadow.w * texel_angle * tan_theta);
+}
+
+// The length that ISR's relative depth threshold multiplies for a child at
+// p (rsm_tree.comp): its distance to the light for perspective RSMs, where a
+// texel's footprint grows with distance. An orthographic texel's footprint
+// is the same everywhere (texel = 2 h / R, h = light_cone.z), equal to a
+// 90 degree perspective texel's at distance h: so h, which keeps the test's
+// meaning (depth offsets measured in texel footprints times R / 2).
+float validity_reach(vec3 p) {
+    if (light_is_directional()) return u.light_cone.z;
+    return distance(p, u.light_position.xyz);
+}
+
+// HISR (gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
+// (mean position pj, node xy at depth d: 2^d x 2^d patches across the RSM)
+// iff |V_ij|^2 <= 4^k * hisr_bound(...), k its levels above the finest.
+// t_finest = 2 (1 - tau) / (3 tau R^2) = dw_talk (1 - tau) / (pi tau) with
+// the talk's texel solid angle dw_talk = 2 pi / (3 R^2).
+//
+// Spot (the talk): C_ij <= I dw / (pi |V_ij|^2 + dw |V_j|^2) > tau I / |V_j|^2
+//   iff |V_ij|^2 < dw (1 - tau) / (pi tau) |V_j|^2 = T |V_j|^2 with dw = dw_talk.
+// Cube face: the same inequality holds with dw the largest texel solid angle
+//   in the patch. On a 90 degree face dw = (2/R)^2 cos^3 alpha, largest at the
+//   patch's point nearest the face centre (alpha smallest); so the bound is
+//   T |V_j|^2 dw_max / dw_talk = T |V_j|^2 * 6 cos^3 alpha_min / pi: exact for
+//   every texel rather than one average solid angle (texels shrink ~5x toward
+//   the face's corners, where this splits less).
+// Orthographic: Phi_j <= E m a and A_j >= m a for the patch's m <= 4^k
+//   non-empty texels of area a = (2h/R)^2 (no light distance), and
+//   Phi / (pi d^2 + A) grows with m: C_ij <= E 4^k a / (pi |V_ij|^2 + 4^k a),
+//   above tau E iff |V_ij|^2 < 4^k a (1 - tau) / (pi tau) = 4^k T a / dw_talk
+//   = 4^k T 6 h^2 / pi.
+float hisr_bound(vec3 pj, ivec3 node, float t_finest) {
+    if (light_is_directional()) {
+        float h = u.light_cone.z;
+        return t_finest * 6.0 * h * h / PI;
+    }
+    vec3 vj = pj - u.light_position.xyz;
+    float bound = t_finest * dot(vj, vj);
+    if (u.light_kind.x == LIGHT_POINT) {
+        // The patch's square on the face's image plane [-1, 1]^2, and its
+        // point nearest the centre.
+        float side = float(1 << node.z);
+        vec2 lo = vec2(node.xy) / side * 2.0 - 1.0;
+        vec2 hi = lo + 2.0 / side;
+        vec2 nearest = clamp(vec2(0.0), lo, hi);
+        float cos_alpha = inversesqrt(1.0 + dot(nearest, nearest));
+        bound *= 6.0 * cos_alpha * cos_alpha * cos_alpha / PI;
+    }
+    return bound;
+}
+
+#endif
