@@ -4,9 +4,9 @@
 // shader, so only patches are shaded. Each patch sums C_{j->i} / rho_i over its
 // light patches at its mean position and normal. Which light patches, is the
 // method (docs/algorithm.md section 4), chosen by LIGHT_PATCHES:
-//   0  regular N VPLs: level k of the RSM quadtree   (multires-gather)
-//   1  the list Basic ISR chose this frame            (isr)
-//   2  a per-fragment traversal of the quadtree       (hisr)
+//   0  a list: the N regular VPLs (vpl_list.comp, multires-gather) or the
+//      patches Basic ISR chose this frame (isr_select.comp, isr)
+//   1  a per-fragment traversal of the packed quadtree (light_tree_pack.comp, hisr)
 // With the stencil off (a measurement baseline) every texel is shaded and
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
@@ -22,17 +22,12 @@ layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // mip chain
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // mip chain
 layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // mip chain
-layout(set = 1, binding = 3) uniform sampler2D rsm_position;  // quadtree (mip chain)
-layout(set = 1, binding = 4) uniform sampler2D rsm_normal;
-layout(set = 1, binding = 5) uniform sampler2D rsm_flux;
-// Basic ISR's chosen list, or HISR's packed quadtree (light_tree_pack.comp).
-layout(set = 1, binding = 6, std430) readonly buffer ChosenPatches {
+// The regular VPLs, Basic ISR's chosen list, or HISR's packed quadtree.
+layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
     uint patch_count;
     uint pad0, pad1, pad2;
     LightPatch patches[];
 };
-
-#include "regular_vpls.glsl"
 
 layout(location = 0) flat in int level;  // the layer (layered.vert)
 
@@ -47,17 +42,10 @@ void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux) {
     evaluations += 1u;
 }
 
-void regular_vpls(vec3 xi, vec3 ni) {
-    for (int j = 0; j < regular_vpl_count(); ++j) {
-        vec4 pos, nrm;
-        vec3 flux;
-        if (regular_vpl(j, pos, nrm, flux)) add_patch(xi, ni, pos, nrm, flux);
-    }
-}
-
-void chosen_list(vec3 xi, vec3 ni) {
+void patch_list(vec3 xi, vec3 ni) {
     for (uint j = 0u; j < patch_count; ++j) {
         LightPatch lp = patches[j];
+        if (lp.position_area.w <= 0.0) continue;  // an empty regular VPL
         add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
     }
 }
@@ -136,9 +124,7 @@ void main() {
     vec3 xi = texelFetch(geo_mean, p, level).xyz;
     vec3 ni = texelFetch(geo_normal, p, level).xyz;
     if (LIGHT_PATCHES == 0) {
-        regular_vpls(xi, ni);
-    } else if (LIGHT_PATCHES == 1) {
-        chosen_list(xi, ni);
+        patch_list(xi, ni);
     } else {
         traverse(xi, ni);
     }

@@ -99,6 +99,7 @@ fn timings_json_from_the_cli_lists_every_pass() {
         "rsm-tree",
         "geometry-mips",
         "stencil-refine",
+        "vpl-list",
         "gather",
         "upsample",
     ];

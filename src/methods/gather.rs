@@ -10,23 +10,24 @@
 
 use super::IndirectMethod;
 use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER};
 use crate::multires::{Multires, MultiresBuffer};
-use crate::passes::INDIRECT_GRAPHICS;
+use crate::passes::{ComputePass, INDIRECT_COMPUTE, INDIRECT_GRAPHICS};
+use crate::vk::barrier;
 use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
 use anyhow::Result;
 use ash::vk;
+use gpu_allocator::MemoryLocation;
 
 /// The light patches of docs/algorithm.md section 4 (`LIGHT_PATCHES` in the shader).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightPatches {
-    /// N regular VPLs: one level of the RSM quadtree.
-    Regular = 0,
-    /// The list Basic ISR chose this frame.
-    ChosenList = 1,
-    /// A per-fragment traversal of the quadtree (HISR).
-    Traversal = 2,
+    /// A list: the N regular VPLs or the patches Basic ISR chose this frame.
+    List = 0,
+    /// A per-fragment traversal of the packed quadtree (HISR).
+    Traversal = 1,
 }
 
 /// What fills the multiresolution buffer's patches: the gather or the splat.
@@ -37,32 +38,19 @@ pub trait FillPass {
 pub struct GatherPass {
     pipeline: PassPipeline,
     stencil: bool,
-    /// Bound where there is no chosen list (the descriptor needs a buffer).
-    _placeholder: Option<Buffer>,
 }
 
 impl GatherPass {
-    /// `chosen` is the light-space pass's buffer: Basic ISR's list or HISR's
-    /// packed tree (`None` for other sources). With
-    /// `--stencil off` the pipeline has no stencil test (measurement baseline).
+    /// `patches` is the light-space pass's buffer: the regular VPLs, Basic
+    /// ISR's list or HISR's packed tree. With `--stencil off` the pipeline has
+    /// no stencil test (measurement baseline).
     pub fn new(
         setup: &Setup,
         m: &MultiresBuffer,
         source: LightPatches,
-        chosen: Option<&Buffer>,
+        patches: &Buffer,
     ) -> Result<Self> {
-        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
-        let placeholder = match chosen {
-            Some(_) => None,
-            None => Some(Buffer::new(
-                gpu,
-                "no chosen patches",
-                crate::gpu_types::CHOSEN_PATCHES_HEADER as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                gpu_allocator::MemoryLocation::GpuOnly,
-            )?),
-        };
-        let chosen = chosen.or(placeholder.as_ref()).expect("one of the two");
+        let (gpu, s) = (setup.gpu, setup.samplers);
         let stencil = setup.settings.multires.stencil;
         let pipeline = PassPipeline::graphics(
             gpu,
@@ -71,10 +59,7 @@ impl GatherPass {
                 Binding::sampled("geo_mean", m.geo_mean.view, s.nearest),
                 Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
                 Binding::sampled("geo_flags", m.geo_flags.view, s.nearest),
-                Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
-                Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
-                Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
-                Binding::storage("ChosenPatches", chosen),
+                Binding::storage("ChosenPatches", patches),
             ],
             GraphicsDesc {
                 name: "gather",
@@ -91,11 +76,7 @@ impl GatherPass {
                 ..Default::default()
             },
         )?;
-        Ok(Self {
-            pipeline,
-            stencil,
-            _placeholder: placeholder,
-        })
+        Ok(Self { pipeline, stencil })
     }
 }
 
@@ -124,6 +105,92 @@ pub trait LightSpacePass {
     /// HISR's packed light tree (read back by tests).
     fn packed_tree(&self) -> Option<&Buffer> {
         None
+    }
+}
+
+/// A light-space pass that fills a buffer of `LightPatch`es (after the
+/// `CHOSEN_PATCHES_HEADER`) with one compute dispatch over `extent`, read by
+/// the gather: `vpl-list` (the regular VPLs) and `light-tree-pack` (HISR's
+/// packed quadtree). Reads the RSM quadtree; writes the buffer.
+pub struct PatchListPass {
+    name: &'static str,
+    pass: ComputePass,
+    buffer: Buffer,
+    extent: vk::Extent2D,
+    /// The buffer is HISR's packed tree (for readback).
+    packed_tree: bool,
+}
+
+impl PatchListPass {
+    /// `shader` binds the RSM quadtree as `rsm_position`, `rsm_normal`,
+    /// `rsm_flux` and the buffer, room for `patches`, as `buffer_name`.
+    pub fn new(
+        setup: &Setup,
+        name: &'static str,
+        shader: &str,
+        buffer_name: &'static str,
+        patches: u64,
+        extent: vk::Extent2D,
+        packed_tree: bool,
+    ) -> Result<Self> {
+        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
+        let buffer = Buffer::new(
+            gpu,
+            name,
+            CHOSEN_PATCHES_HEADER as u64 + patches * std::mem::size_of::<LightPatch>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuOnly,
+        )?;
+        let bindings = vec![
+            Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
+            Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
+            Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
+            Binding::storage(buffer_name, &buffer),
+        ];
+        let pass = ComputePass::new(setup, name, shader, &[bindings], 0, &[])?;
+        Ok(Self {
+            name,
+            pass,
+            buffer,
+            extent,
+            packed_tree,
+        })
+    }
+}
+
+impl LightSpacePass for PatchListPass {
+    fn buffer(&self) -> &Buffer {
+        &self.buffer
+    }
+
+    fn packed_tree(&self) -> Option<&Buffer> {
+        self.packed_tree.then_some(&self.buffer)
+    }
+
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        profiler.pass(gpu, cmd, self.name, INDIRECT_COMPUTE, || {
+            // The previous gather (fragment; of this frame's previous light
+            // view or of the previous frame) and readback (copy) read the
+            // buffer before it is overwritten.
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::NONE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            self.pass.dispatch(ctx, 0, &[], self.extent);
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
+            );
+        });
     }
 }
 

@@ -5,22 +5,33 @@
 //! the bound) and reads the quadtree packed into one buffer by the pass
 //! below; this module makes the method and holds its constants.
 
-use super::gather::{GatherPass, LightPatches, LightSpacePass, MultiresMethod};
-use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER};
-use crate::passes::{ComputePass, INDIRECT_COMPUTE};
-use crate::vk::barrier;
-use crate::vk::pipeline::Binding;
-use crate::vk::profiler::Profiler;
-use crate::vk::Buffer;
-use anyhow::Result;
+use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchListPass};
+use crate::frame::Setup;
+use anyhow::{anyhow, Result};
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 
-/// Method `hisr`: the tree is packed, then the gather traverses it per fragment.
+/// Method `hisr`: pass `light-tree-pack` (`shaders/light_tree_pack.comp`)
+/// copies every node of the RSM quadtree into one buffer, root first, then
+/// the gather traverses it per fragment.
 pub fn new(setup: &Setup) -> Result<MultiresMethod> {
-    let pack = LightTreePackPass::new(setup)?;
+    let r = setup.settings.rsm_resolution as u64;
+    let nodes = (4 * r * r - 1) / 3;
+    // One invocation per node: R wide, enough rows for every node.
+    let extent = vk::Extent2D {
+        width: r as u32,
+        height: nodes.div_ceil(r) as u32,
+    };
+    let pack = PatchListPass::new(
+        setup,
+        "light-tree-pack",
+        "light_tree_pack.comp",
+        "LightTree",
+        nodes,
+        extent,
+        true,
+    )?;
     MultiresMethod::new(setup, Some(Box::new(pack)), |setup, m, tree| {
+        let tree = tree.ok_or_else(|| anyhow!("hisr gathers from its packed tree"))?;
         Ok(Box::new(GatherPass::new(
             setup,
             m,
@@ -28,85 +39,6 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
             tree,
         )?))
     })
-}
-
-/// Pass `light-tree-pack`: `shaders/light_tree_pack.comp`, one dispatch that
-/// copies every node of the RSM quadtree into one buffer. Reads the quadtree;
-/// writes the buffer the gather traverses.
-pub struct LightTreePackPass {
-    pass: ComputePass,
-    tree: Buffer,
-    /// One invocation per node: R wide, enough rows for (4 R^2 - 1) / 3 nodes.
-    extent: vk::Extent2D,
-}
-
-impl LightTreePackPass {
-    pub fn new(setup: &Setup) -> Result<Self> {
-        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
-        let r = setup.settings.rsm_resolution as u64;
-        let nodes = (4 * r * r - 1) / 3;
-        let tree = Buffer::new(
-            gpu,
-            "hisr light tree",
-            CHOSEN_PATCHES_HEADER as u64 + nodes * std::mem::size_of::<LightPatch>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::GpuOnly,
-        )?;
-        let bindings = vec![
-            Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
-            Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
-            Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
-            Binding::storage("LightTree", &tree),
-        ];
-        let pass = ComputePass::new(
-            setup,
-            "light-tree-pack",
-            "light_tree_pack.comp",
-            &[bindings],
-            0,
-            &[],
-        )?;
-        let extent = vk::Extent2D {
-            width: r as u32,
-            height: nodes.div_ceil(r) as u32,
-        };
-        Ok(Self { pass, tree, extent })
-    }
-}
-
-impl LightSpacePass for LightTreePackPass {
-    fn buffer(&self) -> &Buffer {
-        &self.tree
-    }
-
-    fn packed_tree(&self) -> Option<&Buffer> {
-        Some(&self.tree)
-    }
-
-    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
-        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
-        profiler.pass(gpu, cmd, "light-tree-pack", INDIRECT_COMPUTE, || {
-            // The previous frame's gather (fragment) and readback (copy) read
-            // the buffer before it is overwritten.
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::NONE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
-            self.pass.dispatch(ctx, 0, &[], self.extent);
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
-            );
-        });
-    }
 }
 
 /// T at the finest level for `tau` given as a fraction of the light's peak

@@ -14,7 +14,7 @@ use crate::vk::barrier;
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -22,10 +22,11 @@ use gpu_allocator::MemoryLocation;
 pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     let select = IsrSelectPass::new(setup)?;
     MultiresMethod::new(setup, Some(Box::new(select)), |setup, m, chosen| {
+        let chosen = chosen.ok_or_else(|| anyhow!("isr gathers from its chosen list"))?;
         Ok(Box::new(GatherPass::new(
             setup,
             m,
-            LightPatches::ChosenList,
+            LightPatches::List,
             chosen,
         )?))
     })
