@@ -555,12 +555,5 @@ fn render(args: RenderArgs) -> Result<()> {
         );
     }
 
-    let messages = gpu.take_validation_messages();
-    if !messages.is_empty() {
-        bail!(
-            "the validation layer reported {} message(s) (printed above)",
-            messages.len()
-        );
-    }
-    Ok(())
+    gpu.validation_verdict()
 }

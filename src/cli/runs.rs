@@ -168,12 +168,5 @@ pub(super) fn sequence(
         output::write_gif(&gif, args.width, args.height, gif_frames, args.fps)?;
         println!("wrote {}", gif.display());
     }
-    let messages = gpu.take_validation_messages();
-    if !messages.is_empty() {
-        bail!(
-            "the validation layer reported {} message(s) (printed above)",
-            messages.len()
-        );
-    }
-    Ok(())
+    gpu.validation_verdict()
 }

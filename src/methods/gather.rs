@@ -108,17 +108,28 @@ pub trait LightSpacePass {
     }
 }
 
+/// What a [`PatchListPass`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatchList {
+    /// `vpl-list`: the N regular VPLs, VPL j at entry j.
+    RegularVpls,
+    /// `isr-select`: the patches Basic ISR chose, appended with an atomic
+    /// counter (cleared before the dispatch).
+    IsrChosen,
+    /// `light-tree-pack`: HISR's quadtree, a node per entry, root first.
+    PackedTree,
+}
+
 /// A light-space pass that fills a buffer of `LightPatch`es (after the
-/// `CHOSEN_PATCHES_HEADER`) with one compute dispatch over `extent`, read by
-/// the gather: `vpl-list` (the regular VPLs) and `light-tree-pack` (HISR's
-/// packed quadtree). Reads the RSM quadtree; writes the buffer.
+/// `CHOSEN_PATCHES_HEADER`) with one compute dispatch over `extent`, which the
+/// gather then reads: `vpl-list`, `isr-select`, `light-tree-pack`. Reads the
+/// RSM quadtree; writes the buffer (barriers in `record`).
 pub struct PatchListPass {
     name: &'static str,
+    kind: PatchList,
     pass: ComputePass,
     buffer: Buffer,
     extent: vk::Extent2D,
-    /// The buffer is HISR's packed tree (for readback).
-    packed_tree: bool,
 }
 
 impl PatchListPass {
@@ -126,19 +137,19 @@ impl PatchListPass {
     /// `rsm_flux` and the buffer, room for `patches`, as `buffer_name`.
     pub fn new(
         setup: &Setup,
-        name: &'static str,
-        shader: &str,
-        buffer_name: &'static str,
+        kind: PatchList,
+        (name, shader, buffer_name): (&'static str, &str, &'static str),
         patches: u64,
         extent: vk::Extent2D,
-        packed_tree: bool,
     ) -> Result<Self> {
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let buffer = Buffer::new(
             gpu,
             name,
             CHOSEN_PATCHES_HEADER as u64 + patches * std::mem::size_of::<LightPatch>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_SRC
+                | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
         let bindings = vec![
@@ -150,10 +161,10 @@ impl PatchListPass {
         let pass = ComputePass::new(setup, name, shader, &[bindings], 0, &[])?;
         Ok(Self {
             name,
+            kind,
             pass,
             buffer,
             extent,
-            packed_tree,
         })
     }
 }
@@ -163,31 +174,57 @@ impl LightSpacePass for PatchListPass {
         &self.buffer
     }
 
+    fn chosen_list(&self) -> Option<&Buffer> {
+        (self.kind == PatchList::IsrChosen).then_some(&self.buffer)
+    }
+
     fn packed_tree(&self) -> Option<&Buffer> {
-        self.packed_tree.then_some(&self.buffer)
+        (self.kind == PatchList::PackedTree).then_some(&self.buffer)
     }
 
     fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let readers = vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY;
+        let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         profiler.pass(gpu, cmd, self.name, INDIRECT_COMPUTE, || {
             // The previous gather (fragment; of this frame's previous light
             // view or of the previous frame) and readback (copy) read the
             // buffer before it is overwritten.
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::NONE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
+            if self.kind == PatchList::IsrChosen {
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    readers,
+                    vk::AccessFlags2::NONE,
+                    vk::PipelineStageFlags2::ALL_TRANSFER,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                );
+                unsafe { gpu.device.cmd_fill_buffer(cmd, self.buffer.buffer, 0, 4, 0) };
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_TRANSFER,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    rw,
+                );
+            } else {
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    readers,
+                    vk::AccessFlags2::NONE,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                );
+            }
             self.pass.dispatch(ctx, 0, &[], self.extent);
             barrier::memory(
                 gpu,
                 cmd,
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
+                readers,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
             );
         });

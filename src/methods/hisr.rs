@@ -5,7 +5,7 @@
 //! the bound) and reads the quadtree packed into one buffer by the pass
 //! below; this module makes the method and holds its constants.
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchListPass};
+use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchList, PatchListPass};
 use crate::frame::Setup;
 use anyhow::{anyhow, Result};
 use ash::vk;
@@ -23,12 +23,10 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     };
     let pack = PatchListPass::new(
         setup,
-        "light-tree-pack",
-        "light_tree_pack.comp",
-        "LightTree",
+        PatchList::PackedTree,
+        ("light-tree-pack", "light_tree_pack.comp", "LightTree"),
         nodes,
         extent,
-        true,
     )?;
     MultiresMethod::new(setup, Some(Box::new(pack)), |setup, m, tree| {
         let tree = tree.ok_or_else(|| anyhow!("hisr gathers from its packed tree"))?;

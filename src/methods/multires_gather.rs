@@ -5,7 +5,7 @@
 //! buffer once per frame, which the gather then loops over as Basic ISR's
 //! list; the other passes are those of [`MultiresMethod`].
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchListPass};
+use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchList, PatchListPass};
 use crate::frame::Setup;
 use anyhow::{anyhow, Result};
 use ash::vk;
@@ -14,15 +14,13 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     let side = (setup.settings.vpls as f64).sqrt() as u32;
     let list = PatchListPass::new(
         setup,
-        "vpl-list",
-        "vpl_list.comp",
-        "VplList",
+        PatchList::RegularVpls,
+        ("vpl-list", "vpl_list.comp", "VplList"),
         setup.settings.vpls as u64,
         vk::Extent2D {
             width: side,
             height: side,
         },
-        false,
     )?;
     MultiresMethod::new(setup, Some(Box::new(list)), |setup, m, list| {
         let list = list.ok_or_else(|| anyhow!("multires-gather gathers from its VPL list"))?;

@@ -127,14 +127,7 @@ pub fn run(scene: &Scene, options: ViewOptions) -> Result<()> {
     if let Some(e) = error {
         return Err(e);
     }
-    let messages = gpu.take_validation_messages();
-    if !messages.is_empty() {
-        bail!(
-            "the validation layer reported {} message(s) (printed above)",
-            messages.len()
-        );
-    }
-    Ok(())
+    gpu.validation_verdict()
 }
 
 struct App<'g> {

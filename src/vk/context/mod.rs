@@ -467,6 +467,19 @@ impl Gpu {
             .unwrap_or_default()
     }
 
+    /// An error when the validation layer reported anything since the last
+    /// take (the messages were printed as they came).
+    pub fn validation_verdict(&self) -> Result<()> {
+        let messages = self.take_validation_messages();
+        if !messages.is_empty() {
+            bail!(
+                "the validation layer reported {} message(s) (printed above)",
+                messages.len()
+            );
+        }
+        Ok(())
+    }
+
     /// The first of `candidates` whose optimal tiling supports `features`.
     pub fn pick_format(
         &self,
