@@ -19,8 +19,8 @@ layout(early_fragment_tests) in;
 
 layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 
-layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // mip chain
-layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // mip chain
+layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
+layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
 layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // mip chain
 // The regular VPLs, Basic ISR's chosen list, or HISR's packed quadtree.
 layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
@@ -28,6 +28,9 @@ layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
     uint pad0, pad1, pad2;
     LightPatch patches[];
 };
+layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
+layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
+#include "geo_levels.glsl"
 
 layout(location = 0) flat in int level;  // the layer (layered.vert)
 
@@ -121,8 +124,8 @@ void traverse(vec3 xi, vec3 ni) {
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec3 xi = texelFetch(geo_mean, p, level).xyz;
-    vec3 ni = texelFetch(geo_normal, p, level).xyz;
+    vec3 xi = geo_mean_at(p, level).xyz;
+    vec3 ni = geo_normal_at(p, level).xyz;
     if (LIGHT_PATCHES == 0) {
         patch_list(xi, ni);
     } else {

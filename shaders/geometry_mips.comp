@@ -1,6 +1,8 @@
 #version 460
 // One level of the geometry mipmaps (docs/algorithm.md section 3, steps 2-4).
 // Level 0 reads the G-buffer; level l > 0 merges 2x2 texels of level l - 1.
+// Level 0's mean and normal are not stored: readers take them from the
+// G-buffer (geo_levels.glsl), so every chain but the flags holds levels 1..L.
 // Per texel: mean position and view depth, mean normal and coverage, the
 // depth and normal-component ranges, and the flags smooth / split.
 //
@@ -35,6 +37,10 @@ layout(set = 1, binding = 11, r32ui) writeonly uniform uimage2D dst_flags;
 
 layout(push_constant) uniform Push { int level; };
 
+// Level 0 as the other passes read it (levels above come from src_* here).
+#define GEO_LEVEL0_ONLY
+#include "geo_levels.glsl"
+
 const float BIG = 3.0e38;
 
 bool smooth_ranges(vec4 lo, vec4 hi) {
@@ -45,17 +51,9 @@ bool smooth_ranges(vec4 lo, vec4 hi) {
 
 void level_zero(ivec2 p) {
     vec4 pos = texelFetch(gbuffer_position, p, 0);
-    if (pos.w <= 0.0) {
-        imageStore(dst_mean, p, vec4(0.0));
-        imageStore(dst_normal, p, vec4(0.0));
-        imageStore(dst_flags, p, uvec4(0u));
-        return;
-    }
-    // Renormalised: the G-buffer stores normals as 16-bit floats.
-    vec3 n = normalize(texelFetch(gbuffer_normal, p, 0).xyz);
-    imageStore(dst_mean, p, pos);
-    imageStore(dst_normal, p, vec4(n, 1.0));
-    imageStore(dst_flags, p, uvec4(GEO_HAS_GEOMETRY | GEO_SMOOTH));  // level 0 is always smooth
+    // Mean and normal of level 0 are the G-buffer's (geo_levels.glsl): only
+    // the flags are stored. Level 0 is always smooth.
+    imageStore(dst_flags, p, uvec4(pos.w > 0.0 ? GEO_HAS_GEOMETRY | GEO_SMOOTH : 0u));
 }
 
 // Depth and normal ranges of a level-1 texel: the G-buffer's pixels with
@@ -84,8 +82,8 @@ void coarser_level(ivec2 p) {
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
     for (int i = 0; i < 4; ++i) {
         ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
-        vec4 cn = imageLoad(src_normal, c);
-        mean += cn.w * imageLoad(src_mean, c);
+        vec4 cn = level == 1 ? level0_normal(c) : imageLoad(src_normal, c);
+        mean += cn.w * (level == 1 ? level0_mean(c) : imageLoad(src_mean, c));
         normal += cn.w * cn.xyz;
         coverage += cn.w;
         if (level >= 2) {

@@ -8,8 +8,11 @@
 
 layout(early_fragment_tests) in;
 
-layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // mip chain
-layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // mip chain
+layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
+layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
+layout(set = 1, binding = 5) uniform sampler2D gbuffer_position;  // level 0
+layout(set = 1, binding = 6) uniform sampler2D gbuffer_normal;
+#include "geo_levels.glsl"
 
 layout(location = 0) flat in int level;
 layout(location = 1) flat in vec4 in_position;
@@ -21,8 +24,8 @@ layout(location = 1) out float out_evaluations;  // one per splat
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec3 xi = texelFetch(geo_mean, p, level).xyz;
-    vec3 ni = texelFetch(geo_normal, p, level).xyz;
+    vec3 xi = geo_mean_at(p, level).xyz;
+    vec3 ni = geo_normal_at(p, level).xyz;
     out_irradiance = vec4(patch_irradiance(xi, ni, in_position.xyz, in_normal, in_flux, in_position.w), 1.0);
     out_evaluations = 1.0;
 }

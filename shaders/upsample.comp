@@ -17,9 +17,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = 0, rgba32f) uniform image2DArray illumination;
-layout(set = 1, binding = 1) uniform sampler2D geo_mean;    // w: mean view depth
-layout(set = 1, binding = 2) uniform sampler2D geo_normal;  // w: coverage
+layout(set = 1, binding = 1) uniform sampler2D geo_mean;    // levels 1..L; w: mean view depth
+layout(set = 1, binding = 2) uniform sampler2D geo_normal;  // levels 1..L; w: coverage
 layout(set = 1, binding = 3, rgba32f) writeonly uniform image2D indirect;
+layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
+layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
+#include "geo_levels.glsl"
 
 layout(push_constant) uniform Push {
     int level;
@@ -56,11 +59,10 @@ bool same_surface(vec4 mean_a, vec3 n_a, vec4 mean_b, vec3 n_b) {
     return depth_ok <= 0.0 && chord <= 2.0 * run.refine.y;
 }
 
-vec3 interpolate(ivec2 p, vec3 fallback) {
+// `mean` and `n`: this texel's mean position and normal.
+vec3 interpolate(ivec2 p, vec4 mean, vec3 n, vec3 fallback) {
     int up = level + 1;
     ivec2 size = level_size(up);
-    vec4 mean = texelFetch(geo_mean, p, level);
-    vec3 n = texelFetch(geo_normal, p, level).xyz;
     // Texel centre in the coarser level's texel coordinates.
     vec2 c = (vec2(p) + 0.5) * 0.5 - 0.5;
     ivec2 base = ivec2(floor(c));
@@ -81,8 +83,9 @@ vec3 interpolate(ivec2 p, vec3 fallback) {
         vec4 v = vec4(0.0);
         if (valid) {
             v = imageLoad(illumination, ivec3(q, up));
-            vec4 qn = texelFetch(geo_normal, q, up);
-            valid = v.a > 0.0 && qn.w > 0.0 && same_surface(mean, n, texelFetch(geo_mean, q, up), qn.xyz);
+            // Level up >= 1: straight from the chains (mip up - 1).
+            vec4 qn = texelFetch(geo_normal, q, up - 1);
+            valid = v.a > 0.0 && qn.w > 0.0 && same_surface(mean, n, texelFetch(geo_mean, q, up - 1), qn.xyz);
         }
         if (!valid) {
             all_valid = false;
@@ -106,12 +109,21 @@ vec3 interpolate(ivec2 p, vec3 fallback) {
 
 void push_texel(ivec2 p) {
     vec4 v = imageLoad(illumination, ivec3(p, level));
-    bool geometry = texelFetch(geo_normal, p, level).w > 0.0;
+    // This texel's geometry, once (level is uniform: one branch per dispatch).
+    vec4 mean, normal;
+    if (level == 0) {
+        mean = level0_mean(p);
+        normal = level0_normal(p);
+    } else {
+        mean = texelFetch(geo_mean, p, level - 1);
+        normal = texelFetch(geo_normal, p, level - 1);
+    }
+    bool geometry = normal.w > 0.0;
     if (v.a <= 0.0 && geometry) {
         ivec2 parent = p >> 1;
         vec3 nearest = inside(parent, level + 1) ? imageLoad(illumination, ivec3(parent, level + 1)).rgb : vec3(0.0);
         bool interpolated = (run.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
-        v = vec4(interpolated ? interpolate(p, nearest) : nearest, PUSHED);
+        v = vec4(interpolated ? interpolate(p, mean, normal.xyz, nearest) : nearest, PUSHED);
         imageStore(illumination, ivec3(p, level), v);
     }
     if (level == 0) imageStore(indirect, p, vec4(geometry ? v.rgb : vec3(0.0), 1.0));

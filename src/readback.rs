@@ -288,10 +288,15 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
             aspect: vk::ImageAspectFlags::STENCIL,
             ..Region::layer(format!("stencil/{l}"), &m.stencil, l)
         });
-        regions.push(Region::mip(format!("geo_mean/{l}"), &m.geo_mean, l));
-        regions.push(Region::mip(format!("geo_normal/{l}"), &m.geo_normal, l));
+        if l > 0 {
+            regions.push(Region::mip(format!("geo_mean/{l}"), &m.geo_mean, l - 1));
+            regions.push(Region::mip(format!("geo_normal/{l}"), &m.geo_normal, l - 1));
+        }
         regions.push(Region::mip(format!("geo_flags/{l}"), &m.geo_flags, l));
     }
+    // Level 0 of the mean and normal is the G-buffer (`shaders/geo_levels.glsl`).
+    regions.push(Region::mip("gbuffer_position", &t.gbuffer_position, 0));
+    regions.push(Region::mip("gbuffer_normal", &t.gbuffer_normal, 0));
     let rsm_levels = t.rsm_position.mips;
     for k in 0..rsm_levels {
         regions.push(Region::mip(format!("rsm_position/{k}"), &t.rsm_position, k));
@@ -303,8 +308,29 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
         (0..n).map(|l| r.rgba(&format!("{name}/{l}"))).collect()
     };
     let illumination = per_level(&mut r, "illumination")?;
-    let geo_mean = per_level(&mut r, "geo_mean")?;
-    let geo_normal = per_level(&mut r, "geo_normal")?;
+    let level0_mean = r.rgba("gbuffer_position")?;
+    // As `level0_normal` in the shader: renormalised, coverage 1 with geometry.
+    let level0_normal: Vec<[f32; 4]> = r
+        .rgba("gbuffer_normal")?
+        .iter()
+        .zip(&level0_mean)
+        .map(|(n, p)| {
+            if p[3] <= 0.0 {
+                return [0.0; 4];
+            }
+            let v = glam::Vec3::new(n[0], n[1], n[2]).normalize();
+            [v.x, v.y, v.z, 1.0]
+        })
+        .collect();
+    let mut above = |name: &str| -> Result<Vec<Vec<[f32; 4]>>> {
+        (1..n).map(|l| r.rgba(&format!("{name}/{l}"))).collect()
+    };
+    let geo_mean: Vec<_> = std::iter::once(level0_mean)
+        .chain(above("geo_mean")?)
+        .collect();
+    let geo_normal: Vec<_> = std::iter::once(level0_normal)
+        .chain(above("geo_normal")?)
+        .collect();
     // Counts are stored as f32 (exact below 2^24) so that splats can add them.
     let evaluations = (0..n)
         .map(|l| {

@@ -50,7 +50,7 @@ impl GatherPass {
         source: LightPatches,
         patches: &Buffer,
     ) -> Result<Self> {
-        let (gpu, s) = (setup.gpu, setup.samplers);
+        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let stencil = setup.settings.multires.stencil;
         let pipeline = PassPipeline::graphics(
             gpu,
@@ -60,6 +60,8 @@ impl GatherPass {
                 Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
                 Binding::sampled("geo_flags", m.geo_flags.view, s.nearest),
                 Binding::storage("ChosenPatches", patches),
+                Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
             ],
             GraphicsDesc {
                 name: "gather",

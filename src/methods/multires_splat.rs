@@ -41,6 +41,8 @@ impl MultiresSplatPass {
                 Binding::sampled("rsm_position", t.rsm_position.view, s.nearest),
                 Binding::sampled("rsm_normal", t.rsm_normal.view, s.nearest),
                 Binding::sampled("rsm_flux", t.rsm_flux.view, s.nearest),
+                Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
             ],
             GraphicsDesc {
                 name: "splat",

@@ -16,6 +16,8 @@ pub struct GeometryMipsPass(ComputePass);
 /// bindings, in `MultiresBuffer::geometry_images` order.
 const SOURCES: [&str; 5] = ["src_mean", "src_normal", "src_min", "src_max", "src_flags"];
 const DESTINATIONS: [&str; 5] = ["dst_mean", "dst_normal", "dst_min", "dst_max", "dst_flags"];
+/// The flags chain's place in `geometry_images` (the only one with level 0).
+const FLAGS: usize = 4;
 
 impl GeometryMipsPass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
@@ -27,26 +29,22 @@ impl GeometryMipsPass {
                     Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                     Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
                 ];
-                // Mean, normal and flags chains hold levels 0..=L; the range
-                // chains levels 1..=L (mip m is level m + 1). Bindings a level
-                // does not use (level 0's sources and ranges, level 1's source
-                // ranges) point at a mip it does not write.
-                let unused_range = |dst: usize| if dst == 0 { m.levels as usize - 1 } else { 0 };
-                let range_dst = l.saturating_sub(1);
+                // The flags chain holds levels 0..=L; the other four levels
+                // 1..=L (mip m is level m + 1; level 0 is the G-buffer).
+                // Bindings a level does not use (level 0's sources and
+                // destinations in those four, level 1's sources) point at a
+                // mip it does not write.
+                let unused = |dst: usize| if dst == 0 { m.levels as usize - 1 } else { 0 };
                 let (src, dst): (Vec<usize>, Vec<usize>) = images
                     .iter()
                     .enumerate()
                     .map(|(k, _)| {
-                        if k == 2 || k == 3 {
-                            let src = if l >= 2 {
-                                l - 2
-                            } else {
-                                unused_range(range_dst)
-                            };
-                            let dst = if l >= 1 { range_dst } else { unused_range(0) };
-                            (src, dst)
-                        } else {
+                        if k == FLAGS {
                             (l.saturating_sub(1), l)
+                        } else {
+                            let dst = if l >= 1 { l - 1 } else { unused(0) };
+                            let src = if l >= 2 { l - 2 } else { unused(dst) };
+                            (src, dst)
                         }
                     })
                     .unzip();

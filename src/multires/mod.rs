@@ -24,7 +24,8 @@ pub struct MultiresBuffer {
     pub levels: u32,
     pub geo_mean: Image,
     pub geo_normal: Image,
-    /// Depth and normal-component ranges of levels 1..=L (mip m is level m + 1).
+    /// Mean position and normal, depth and normal-component ranges of levels
+    /// 1..=L (mip m is level m + 1; level 0 is the G-buffer).
     pub geo_min: Image,
     pub geo_max: Image,
     pub geo_flags: Image,
@@ -105,8 +106,9 @@ impl MultiresBuffer {
                 },
             )
         };
-        // Depth and normal ranges start at level 1 (level 0's come from the
-        // G-buffer directly): mip m of these chains is level m + 1.
+        // Mean position, normal and the depth and normal ranges start at
+        // level 1 (level 0 is the G-buffer, `shaders/geo_levels.glsl`): mip
+        // m of these chains is level m + 1.
         let range_chain = |name| {
             Image::new(
                 gpu,
@@ -126,8 +128,8 @@ impl MultiresBuffer {
         let rgba = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Self {
             levels,
-            geo_mean: mip_chain("geo_mean", rgba)?,
-            geo_normal: mip_chain("geo_normal", rgba)?,
+            geo_mean: range_chain("geo_mean")?,
+            geo_normal: range_chain("geo_normal")?,
             geo_min: range_chain("geo_min")?,
             geo_max: range_chain("geo_max")?,
             geo_flags: mip_chain("geo_flags", vk::Format::R32_UINT)?,

@@ -22,6 +22,8 @@ impl UpsamplePass {
             Binding::sampled("geo_mean", m.geo_mean.view, s.nearest),
             Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
             Binding::storage_image("indirect", t.indirect.view),
+            Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+            Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
         ];
         Ok(Self(ComputePass::new(
             setup,
