@@ -69,8 +69,9 @@ impl Method {
 /// The light-space hierarchy (docs/algorithm.md section 4).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightTreeSettings {
-    /// A patch is valid (one surface) when its children's distances to the
-    /// light differ by less than this fraction of the nearest.
+    /// A patch is valid (one surface) when each non-empty child's mean lies
+    /// within this fraction of its distance to the light (for an orthographic
+    /// RSM, of the RSM's half side) of the patch's plane (`rsm_tree.comp`).
     pub depth_threshold: f32,
     /// ... and their normals by less than this angle (degrees).
     pub normal_threshold_deg: f32,
