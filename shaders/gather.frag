@@ -12,7 +12,6 @@
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "light_types.glsl"
-#include "multires.glsl"
 #include "vpl.glsl"
 
 layout(early_fragment_tests) in;
@@ -21,7 +20,7 @@ layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
-layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // mip chain
+layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // levels 1..L
 // The regular VPLs, Basic ISR's chosen list, or HISR's packed quadtree.
 layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
     uint patch_count;
@@ -30,6 +29,7 @@ layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
 };
 layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
 layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
+#define GEO_FLAGS
 #include "geo_levels.glsl"
 
 layout(location = 0) flat in int level;  // the layer (layered.vert)
@@ -132,7 +132,7 @@ void main() {
         traverse(xi, ni);
     }
     float is = 1.0;
-    if ((run.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(geo_flags, level, run.hierarchy.x, p)) {
+    if ((run.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(level, run.hierarchy.x, p)) {
         is = 0.0;
         e = vec3(0.0);
         evaluations = 0u;

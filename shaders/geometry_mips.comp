@@ -1,16 +1,16 @@
 #version 460
-// One level of the geometry mipmaps (docs/algorithm.md section 3, steps 2-4).
-// Level 0 reads the G-buffer; level l > 0 merges 2x2 texels of level l - 1.
-// Level 0's mean and normal are not stored: readers take them from the
-// G-buffer (geo_levels.glsl), so every chain but the flags holds levels 1..L.
-// Per texel: mean position and view depth, mean normal and coverage, the
-// depth and normal-component ranges, and the flags smooth / split.
+// One level l >= 1 of the geometry mipmaps (docs/algorithm.md section 3, steps
+// 2-4): merges 2x2 texels of level l - 1. Level 0 is the G-buffer itself and
+// is not stored (geo_levels.glsl): level 1 reads the G-buffer, and every
+// chain holds levels 1..L (mip m is level m + 1). Per texel: mean position
+// and view depth, mean normal and coverage, the depth and normal-component
+// ranges, and the flags smooth / split.
 //
 // Discontinuities on texel borders: every texel's range covers its footprint
 // plus a one-pixel ring, so an edge lying exactly on a border is seen by the
 // texels on both sides. Level 1 takes its ranges straight from the G-buffer's
 // 4x4 pixels (its 2x2 children and their ring); level 0 needs none (it is
-// always smooth), which saves a 3x3 neighbourhood per pixel and two images.
+// always smooth).
 //
 // 2:1 balance: a texel splits if it is not smooth, or if any texel of level
 // l - 1 in the 4x4 block around its children (its children and the ring of
@@ -21,8 +21,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
-// Level l - 1 (unused at level 0; the ranges are unused at level 1 too, and
-// the range images hold levels 1..L).
+// Level l - 1 (unused at level 1, which reads the G-buffer).
 layout(set = 1, binding = 2, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
 layout(set = 1, binding = 3, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
 layout(set = 1, binding = 4, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
@@ -47,13 +46,6 @@ bool smooth_ranges(vec4 lo, vec4 hi) {
     bool depth_ok = (hi.x - lo.x) < run.refine.x * lo.x;
     bool normal_ok = length(hi.yzw - lo.yzw) < run.refine.y;
     return depth_ok && normal_ok;
-}
-
-void level_zero(ivec2 p) {
-    vec4 pos = texelFetch(gbuffer_position, p, 0);
-    // Mean and normal of level 0 are the G-buffer's (geo_levels.glsl): only
-    // the flags are stored. Level 0 is always smooth.
-    imageStore(dst_flags, p, uvec4(pos.w > 0.0 ? GEO_HAS_GEOMETRY | GEO_SMOOTH : 0u));
 }
 
 // Depth and normal ranges of a level-1 texel: the G-buffer's pixels with
@@ -102,7 +94,8 @@ void coarser_level(ivec2 p) {
         if (coverage == 4.0 && smooth_ranges(lo, hi)) flags |= GEO_SMOOTH;
         bool split = (flags & GEO_SMOOTH) == 0u;
         ivec2 below = imageSize(src_flags);
-        for (int dy = -1; dy <= 2 && !split; ++dy) {
+        // Level 0 never splits: level 1 has no finer splits to look at.
+        for (int dy = -1; dy <= 2 && !split && level >= 2; ++dy) {
             for (int dx = -1; dx <= 2; ++dx) {
                 ivec2 q = 2 * p + ivec2(dx, dy);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, below))) continue;
@@ -124,9 +117,5 @@ void coarser_level(ivec2 p) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(dst_flags)))) return;
-    if (level == 0) {
-        level_zero(p);
-    } else {
-        coarser_level(p);
-    }
+    coarser_level(p);
 }

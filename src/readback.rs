@@ -3,7 +3,7 @@
 //! decoded by name, so adding or reordering a region cannot shift the others.
 
 use crate::frame::Targets;
-use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER};
+use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER, GEO_HAS_GEOMETRY, GEO_SMOOTH};
 use crate::multires::MultiresBuffer;
 use crate::vk::barrier::{self, Use};
 use crate::vk::resources::texel_bytes;
@@ -291,8 +291,8 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
         if l > 0 {
             regions.push(Region::mip(format!("geo_mean/{l}"), &m.geo_mean, l - 1));
             regions.push(Region::mip(format!("geo_normal/{l}"), &m.geo_normal, l - 1));
+            regions.push(Region::mip(format!("geo_flags/{l}"), &m.geo_flags, l - 1));
         }
-        regions.push(Region::mip(format!("geo_flags/{l}"), &m.geo_flags, l));
     }
     // Level 0 of the mean and normal is the G-buffer (`shaders/geo_levels.glsl`).
     regions.push(Region::mip("gbuffer_position", &t.gbuffer_position, 0));
@@ -342,8 +342,19 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
     let stencil = (0..n)
         .map(|l| r.bytes(&format!("stencil/{l}")))
         .collect::<Result<Vec<_>>>()?;
-    let geo_flags = (0..n)
-        .map(|l| r.words(&format!("geo_flags/{l}")))
+    // Level 0 is always smooth where there is geometry (`geo_flags_at`).
+    let level0_flags = geo_mean[0]
+        .iter()
+        .map(|p| {
+            if p[3] > 0.0 {
+                GEO_HAS_GEOMETRY | GEO_SMOOTH
+            } else {
+                0
+            }
+        })
+        .collect();
+    let geo_flags = std::iter::once(Ok(level0_flags))
+        .chain((1..n).map(|l| r.words(&format!("geo_flags/{l}"))))
         .collect::<Result<Vec<_>>>()?;
     let rsm_tree = (0..rsm_levels)
         .map(|k| {

@@ -1,6 +1,7 @@
-//! Pass `geometry-mips`: levels 0..=L of the geometry mipmaps (docs/algorithm.md
+//! Pass `geometry-mips`: levels 1..=L of the geometry mipmaps (docs/algorithm.md
 //! section 3, steps 2-4) with `shaders/geometry_mips.comp`, one dispatch per
-//! level. Reads the G-buffer; writes `geo_*` (barriers below).
+//! level (level 0 is the G-buffer itself). Reads the G-buffer; writes `geo_*`
+//! (barriers below).
 
 use super::MultiresBuffer;
 use crate::frame::{FrameContext, Setup};
@@ -16,38 +17,23 @@ pub struct GeometryMipsPass(ComputePass);
 /// bindings, in `MultiresBuffer::geometry_images` order.
 const SOURCES: [&str; 5] = ["src_mean", "src_normal", "src_min", "src_max", "src_flags"];
 const DESTINATIONS: [&str; 5] = ["dst_mean", "dst_normal", "dst_min", "dst_max", "dst_flags"];
-/// The flags chain's place in `geometry_images` (the only one with level 0).
-const FLAGS: usize = 4;
 
 impl GeometryMipsPass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
         let (t, s) = (setup.targets, setup.samplers);
         let images = m.geometry_images();
-        let variants: Vec<Vec<Binding>> = (0..=m.levels as usize)
+        // Every chain holds levels 1..=L (mip m is level m + 1; level 0 is
+        // the G-buffer). Level 1 reads the G-buffer, so its source bindings
+        // are unused and point at a mip it does not write.
+        let variants: Vec<Vec<Binding>> = (1..=m.levels as usize)
             .map(|l| {
                 let mut b = vec![
                     Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                     Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
                 ];
-                // The flags chain holds levels 0..=L; the other four levels
-                // 1..=L (mip m is level m + 1; level 0 is the G-buffer).
-                // Bindings a level does not use (level 0's sources and
-                // destinations in those four, level 1's sources) point at a
-                // mip it does not write.
-                let unused = |dst: usize| if dst == 0 { m.levels as usize - 1 } else { 0 };
-                let (src, dst): (Vec<usize>, Vec<usize>) = images
-                    .iter()
-                    .enumerate()
-                    .map(|(k, _)| {
-                        if k == FLAGS {
-                            (l.saturating_sub(1), l)
-                        } else {
-                            let dst = if l >= 1 { l - 1 } else { unused(0) };
-                            let src = if l >= 2 { l - 2 } else { unused(dst) };
-                            (src, dst)
-                        }
-                    })
-                    .unzip();
+                let dst = vec![l - 1; images.len()];
+                let unused = if l == 1 { m.levels as usize - 1 } else { l - 2 };
+                let src = vec![unused; images.len()];
                 b.extend(
                     images
                         .iter()
@@ -86,13 +72,13 @@ impl GeometryMipsPass {
                 Use::DISCARD_AFTER_READERS,
                 Use::COMPUTE_STORAGE,
             );
-            for level in 0..=m.levels {
-                if level > 0 {
+            for level in 1..=m.levels {
+                if level > 1 {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 let push = (level as i32).to_ne_bytes();
                 self.0
-                    .dispatch(ctx, level as usize, &push, m.geo_flags.mip_extent(level));
+                    .dispatch(ctx, level as usize - 1, &push, m.level_extent(level));
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });

@@ -16,16 +16,16 @@ use gpu_allocator::MemoryLocation;
 
 pub use crate::settings::{default_levels, MultiresSettings, Upsample, MAX_LEVELS};
 
-/// The images of the hierarchy. Geometry mips are mip chains of W x H images
-/// (mip l is (W >> l) x (H >> l)); the illumination buffer and its stencil are
-/// 2D arrays with one W x H layer per level, layer l using its corner.
+/// The images of the hierarchy. Geometry mips are mip chains holding levels
+/// 1..=L (mip m is level m + 1, (W >> (m + 1)) x (H >> (m + 1))); level 0 is
+/// the G-buffer itself (`shaders/geo_levels.glsl`). The illumination buffer and
+/// its stencil are 2D arrays with one W x H layer per level, layer l using
+/// its corner.
 pub struct MultiresBuffer {
     /// Coarsest level L; levels are 0..=L.
     pub levels: u32,
     pub geo_mean: Image,
     pub geo_normal: Image,
-    /// Mean position and normal, depth and normal-component ranges of levels
-    /// 1..=L (mip m is level m + 1; level 0 is the G-buffer).
     pub geo_min: Image,
     pub geo_max: Image,
     pub geo_flags: Image,
@@ -80,19 +80,6 @@ impl MultiresBuffer {
         let storage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::TRANSFER_SRC;
-        let mip_chain = |name, format| {
-            Image::new(
-                gpu,
-                &ImageDesc {
-                    name,
-                    format,
-                    extent,
-                    layers: 1,
-                    mips: levels + 1,
-                    usage: storage,
-                },
-            )
-        };
         let layered = |name, format, usage| {
             Image::new(
                 gpu,
@@ -106,15 +93,14 @@ impl MultiresBuffer {
                 },
             )
         };
-        // Mean position, normal and the depth and normal ranges start at
-        // level 1 (level 0 is the G-buffer, `shaders/geo_levels.glsl`): mip
-        // m of these chains is level m + 1.
-        let range_chain = |name| {
+        // Every geometry-mip chain starts at level 1 (level 0 is the G-buffer,
+        // `shaders/geo_levels.glsl`): mip m of these chains is level m + 1.
+        let chain = |name, format| {
             Image::new(
                 gpu,
                 &ImageDesc {
                     name,
-                    format: vk::Format::R32G32B32A32_SFLOAT,
+                    format,
                     extent: vk::Extent2D {
                         width: width >> 1,
                         height: height >> 1,
@@ -128,11 +114,11 @@ impl MultiresBuffer {
         let rgba = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Self {
             levels,
-            geo_mean: range_chain("geo_mean")?,
-            geo_normal: range_chain("geo_normal")?,
-            geo_min: range_chain("geo_min")?,
-            geo_max: range_chain("geo_max")?,
-            geo_flags: mip_chain("geo_flags", vk::Format::R32_UINT)?,
+            geo_mean: chain("geo_mean", rgba)?,
+            geo_normal: chain("geo_normal", rgba)?,
+            geo_min: chain("geo_min", rgba)?,
+            geo_max: chain("geo_max", rgba)?,
+            geo_flags: chain("geo_flags", vk::Format::R32_UINT)?,
             illumination: layered(
                 "illumination",
                 rgba,
@@ -171,10 +157,21 @@ impl MultiresBuffer {
     /// Texels in the used corners of all layers: what a gather without the
     /// stencil shades.
     pub fn total_area(&self) -> u64 {
-        let e = self.illumination.extent;
         (0..=self.levels)
-            .map(|l| (e.width >> l) as u64 * (e.height >> l) as u64)
+            .map(|l| {
+                let e = self.level_extent(l);
+                e.width as u64 * e.height as u64
+            })
             .sum()
+    }
+
+    /// The used corner of level `l`: (W >> l) x (H >> l).
+    pub fn level_extent(&self, l: u32) -> vk::Extent2D {
+        let e = self.illumination.extent;
+        vk::Extent2D {
+            width: e.width >> l,
+            height: e.height >> l,
+        }
     }
 
     /// Records `draw` into every layer of the illumination buffer and the

@@ -17,9 +17,20 @@ pub struct StencilRefinePass(PassPipeline);
 
 impl StencilRefinePass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
+        let t = setup.targets;
         let bindings = [
             Binding::sampled("geo_flags", m.geo_flags.view, setup.samplers.nearest),
             Binding::storage("PatchCounts", &m.patch_counts),
+            Binding::sampled(
+                "gbuffer_position",
+                t.gbuffer_position.view,
+                setup.samplers.nearest,
+            ),
+            Binding::sampled(
+                "gbuffer_normal",
+                t.gbuffer_normal.view,
+                setup.samplers.nearest,
+            ),
         ];
         Ok(Self(PassPipeline::graphics(
             setup.gpu,

@@ -57,8 +57,7 @@ impl UpsamplePass {
                 }
                 first = false;
                 let push = push_bytes(&[level as i32, pull as i32]);
-                self.0
-                    .dispatch(ctx, 0, &push, m.geo_flags.mip_extent(level));
+                self.0.dispatch(ctx, 0, &push, m.level_extent(level));
             };
             for level in 1..=m.levels {
                 run(level, true);
