@@ -11,7 +11,8 @@
 // fine values. PUSH (levels L-1..0): texels without a value take their parent's
 // value (nearest) or bilinear weights over the four nearest coarser texels,
 // renormalised over those that hold a value and are on the same surface (no
-// depth or normal discontinuity). Level 0 is written to the indirect image.
+// depth or normal discontinuity). Level 0 is written to the indirect image
+// (and its pushed texels only there).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -124,7 +125,9 @@ void push_texel(ivec2 p) {
         vec3 nearest = inside(parent, level + 1) ? imageLoad(illumination, ivec3(parent, level + 1)).rgb : vec3(0.0);
         bool interpolated = (run.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
         v = vec4(interpolated ? interpolate(p, mean, normal.xyz, nearest) : nearest, PUSHED);
-        imageStore(illumination, ivec3(p, level), v);
+        // Level 0's pushed values go only to `indirect`: nothing reads them
+        // from the buffer, and a store per pixel is costly on CPU drivers.
+        if (level > 0) imageStore(illumination, ivec3(p, level), v);
     }
     if (level == 0) imageStore(indirect, p, vec4(geometry ? v.rgb : vec3(0.0), 1.0));
 }
