@@ -455,13 +455,12 @@ impl<'g> Renderer<'g> {
     fn complete(&mut self, slot: usize, stats: &mut FrameStats) -> Result<()> {
         let gpu = self.gpu;
         let s = &mut self.slots[slot];
-        let Some((frame, submitted)) = s.in_flight.take() else {
+        let Some((_, submitted)) = s.in_flight.take() else {
             return Ok(());
         };
         gpu.wait(s.fence)?;
         stats.wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
         stats.frames.push(s.profiler.read(gpu)?);
-        debug_assert_eq!(stats.frames.len() as u32, frame + 1);
         Ok(())
     }
 
@@ -612,6 +611,13 @@ impl<'g> Renderer<'g> {
             bail!("set_method_settings cannot change the output size or the RSM resolution");
         }
         check_settings(self.gpu, settings)?;
+        check_light_views(
+            self.gpu,
+            settings,
+            &self.state.lights,
+            self.views.len(),
+            self.state.instance_transforms.len(),
+        )?;
         // The frames in flight were of the old method; their numbers go.
         self.wait_idle()?;
         let gpu = self.gpu;
