@@ -122,6 +122,26 @@ pub fn expected_direct(light: &SpotLight, albedo: Vec4, p: DVec3, n: DVec3) -> D
     albedo.truncate().as_dvec3() / std::f64::consts::PI * light.intensity_toward(p) * cos / r2
 }
 
+/// Expects `out` (a run of the `isr` binary for `args`) to have failed with
+/// an `error:` message and no panic; returns its stderr.
+pub fn clean_failure(out: &std::process::Output, args: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        !out.status.success(),
+        "expected failure for {args:?}; stderr:\n{stderr}"
+    );
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("RUST_BACKTRACE"),
+        "panic for {args:?}:\n{stderr}"
+    );
+    assert!(
+        stderr.contains("error:"),
+        "no error message for {args:?}:\n{stderr}"
+    );
+    println!("{args:?}:\n{stderr}");
+    stderr
+}
+
 pub fn bin() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_isr"))
 }
