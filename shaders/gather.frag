@@ -7,12 +7,17 @@
 //   0  a list: the N regular VPLs (vpl_list.comp, multires-gather) or the
 //      patches Basic ISR chose this frame (isr_select.comp, isr)
 //   1  a per-fragment traversal of the packed quadtree (light_tree_pack.comp, hisr)
+//   2  the same traversal, started from the fragment's tile's cut
+//      (hisr_cut.comp, hisr with --hisr-tile-level K > 0)
 // With the stencil off (a measurement baseline) every texel is shaded and
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_vote : require
 #include "frame.glsl"
 #include "light_types.glsl"
 #include "vpl.glsl"
+#include "hisr.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -29,6 +34,12 @@ layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
 };
 layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
 layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
+// HISR's per-tile cuts (read only when LIGHT_PATCHES == 2; other methods bind
+// ChosenPatches' buffer here).
+layout(set = 1, binding = 6, std430) readonly buffer HisrCut {
+    HisrCutHeader cut_header;
+    uint cut[];  // counts[tiles], then capacity entries per tile
+};
 #define GEO_FLAGS
 #include "geo_levels.glsl"
 
@@ -79,46 +90,81 @@ void patch_list(vec3 xi, vec3 ni) {
 // costs about 520 evaluations per fragment in the Cornell box whatever tau
 // is; docs/algorithm.md section 4.3 has the measurements behind the scale.
 //
-// Depth-first with a fixed stack and no recursion; children are pushed only
-// above the max depth and when they fit, so every read is inside the tree
-// (a full stack evaluates the patch instead of splitting it). Depth d holds
-// 2^d x 2^d patches and the tree is at most 12 deep (RSM 4096), so the stack
-// holds at most 3 per depth plus the root: 40 entries.
-//
+// Depth-first without a stack: the tree is implicit (a node's children are
+// (2x + i, 2y + j) one depth down), so the next node after one that is not
+// split is its next sibling, or that of the nearest ancestor that has one,
+// found by arithmetic. Children are taken in the order (0,0), (1,0), (0,1),
+// (1,1). No per-fragment array: on GPUs a stack spills to memory, and CPU
+// drivers turn each indexed access into selects over all its entries.
 // The nodes come from the packed tree (light_tree_pack.comp, bound as
-// ChosenPatches): node (x, y) of depth d is patches[(4^d - 1) / 3 + y 2^d + x].
-const int STACK_SIZE = 40;
-
-int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
-
-void traverse(vec3 xi, vec3 ni) {
-    int top = run.light_levels.w;  // mip of the single root patch
-    int start = run.light_levels.x;
+// ChosenPatches; node_index in hisr.glsl).
+void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
     int max_depth = run.light_levels.y;
-    float t_finest = run.light_tree.x;
-    ivec3 stack[STACK_SIZE];  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
-    int side = 1 << start;
-    for (int s = 0; s < side * side; ++s) {
-        int sp = 0;
-        stack[sp++] = ivec3(s % side, s / side, start);
-        while (sp > 0) {
-            ivec3 node = stack[--sp];
-            LightPatch lp = patches[node_index(node)];
-            if (lp.position_area.w <= 0.0) continue;  // saw nothing
+    ivec3 node = root;  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
+    for (;;) {
+        LightPatch lp = patches[node_index(node)];
+        if (lp.position_area.w > 0.0) {  // else: saw nothing
             bool split = false;
-            if (node.z < max_depth && sp + 4 <= STACK_SIZE) {
-                int mip = top - node.z;
+            if (node.z < max_depth) {
                 vec3 vij = lp.position_area.xyz - xi;
-                float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, t_finest);
-                if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
-                split = dot(vij, vij) <= reach;
+                split = dot(vij, vij) <= hisr_reach(lp, node);
             }
             if (split) {
-                for (int i = 3; i >= 0; --i) stack[sp++] = ivec3(2 * node.xy + ivec2(i & 1, i >> 1), node.z + 1);
-            } else {
-                add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+                node = ivec3(2 * node.xy, node.z + 1);
+                continue;
             }
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
         }
+        // Up past the last children (1, 1), then on to the next sibling.
+        while (node.z > root.z && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
+        if (node.z == root.z) return;
+        node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
+    }
+}
+
+// From the 2^s x 2^s patches of the start depth.
+void traverse(vec3 xi, vec3 ni) {
+    int start = run.light_levels.x;
+    int side = 1 << start;
+    for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start));
+}
+
+// The cut of tile t (hisr_cut.comp): its "evaluate" entries are the same for
+// every receiver of the tile, and are summed first in a plain list loop; only
+// the "traverse" entries are walked per fragment.
+void walk_cut(vec3 xi, vec3 ni, uint t) {
+    uint counts = t == HISR_CUT_OVERFLOW ? t : cut[t];
+    if (counts == HISR_CUT_OVERFLOW) {
+        traverse(xi, ni);
+        return;
+    }
+    uint base = cut_header.tiles.x * cut_header.tiles.y + t * cut_header.tiles.w;
+    uint evaluate = counts & 0xffffu;
+    for (uint i = 0u; i < evaluate; ++i) {
+        LightPatch lp = patches[node_index(cut_node(cut[base + i]))];
+        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+    }
+    uint last = base + cut_header.tiles.w - 1u;
+    for (uint i = 0u; i < counts >> 16; ++i) traverse_from(xi, ni, cut_node(cut[last - i]));
+}
+
+// From the cut of the tile holding texel p of this level. Levels coarser than
+// the tile, and tiles whose cut overflowed, traverse from the roots. When a
+// subgroup's lanes share their tile (the common case: neighbouring texels of
+// one layer), the tile is made subgroup-uniform (subgroupBroadcastFirst), so
+// its entries and the nodes they name are loaded once for all lanes rather
+// than once per lane.
+void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
+    int k = int(cut_header.tiles.z);
+    uint mine = HISR_CUT_OVERFLOW;
+    if (level <= k) {
+        ivec2 tile = p >> (k - level);
+        mine = uint(tile.y) * cut_header.tiles.x + uint(tile.x);
+    }
+    if (subgroupAllEqual(mine)) {
+        walk_cut(xi, ni, subgroupBroadcastFirst(mine));
+    } else {
+        walk_cut(xi, ni, mine);
     }
 }
 
@@ -128,8 +174,10 @@ void main() {
     vec3 ni = geo_normal_at(p, level).xyz;
     if (LIGHT_PATCHES == 0) {
         patch_list(xi, ni);
-    } else {
+    } else if (LIGHT_PATCHES == 1) {
         traverse(xi, ni);
+    } else {
+        traverse_cut(xi, ni, p);
     }
     float is = 1.0;
     if ((run.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(level, run.hierarchy.x, p)) {

@@ -77,6 +77,20 @@ const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR 
 // (gather.frag, docs/algorithm.md section 4.3).
 const float HISR_INVALID_TAU_SCALE = 0.01;
 
+// Header of HISR's per-tile cut buffer (hisr_cut.comp writes it, gather.frag
+// reads it; docs/algorithm.md section 4.4). After it: uint counts[tiles.x *
+// tiles.y], then capacity entries per tile (cut_entry in hisr.glsl): a tile's
+// "evaluate" entries from the front of its range, its "traverse" entries from
+// the back. A count holds the evaluate entries in bits 0-15 and the traverse
+// entries in bits 16-31, or is HISR_CUT_OVERFLOW.
+struct HisrCutHeader {
+    uvec4 tiles;  // x, y: tiles per row and per column; z: tile level K (a tile covers
+                  // 2^K x 2^K pixels); w: capacity, entries per tile
+};
+
+// A tile whose cut did not fit: its fragments traverse from the roots.
+const uint HISR_CUT_OVERFLOW = 4294967295u;
+
 // hierarchy.w bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
 const int HIERARCHY_INTERPOLATE = 2;   // interpolated (not nearest) upsampling

@@ -93,6 +93,19 @@ pub struct LightPatch {
 /// Header of the chosen-patch buffer before the `LightPatch` array.
 pub const CHOSEN_PATCHES_HEADER: usize = 16;
 
+/// `HisrCutHeader` (std430): the head of HISR's per-tile cut buffer
+/// (`shaders/hisr_cut.comp`), followed by a count per tile and `tiles[3]`
+/// entries per tile.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HisrCutHeader {
+    /// Tiles per row and per column, tile level K, entries per tile.
+    pub tiles: [u32; 4],
+}
+
+/// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.
+pub const HISR_CUT_OVERFLOW: u32 = u32::MAX;
+
 /// RSM quadtree `normal.w` values, as in `shaders/shared.glsl`.
 pub const PATCH_EMPTY: f32 = 0.0;
 pub const PATCH_VALID: f32 = 1.0;

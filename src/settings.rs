@@ -85,6 +85,10 @@ pub struct LightTreeSettings {
     pub max_depth: Option<u32>,
     /// HISR's error threshold tau, as a fraction of the light's peak intensity.
     pub tau: f32,
+    /// HISR's eye-space tiles cover 2^K x 2^K pixels: the traversal shared by
+    /// a tile's receivers is found once per tile (`hisr-cut`, docs/algorithm.md
+    /// section 4.4). 0: every fragment traverses from the roots.
+    pub hisr_tile_level: u32,
 }
 
 impl LightTreeSettings {
@@ -95,6 +99,7 @@ impl LightTreeSettings {
         start_level: 2,
         max_depth: None,
         tau: 0.05,
+        hisr_tile_level: 4,
     };
 }
 
@@ -161,6 +166,9 @@ impl Default for MultiresSettings {
 pub fn default_levels(width: u32, height: u32) -> u32 {
     (width.min(height).max(2).ilog2().saturating_sub(4)).clamp(1, 8)
 }
+
+/// The largest `--hisr-tile-level` (tiles of 256 x 256 pixels).
+pub const HISR_MAX_TILE_LEVEL: u32 = 8;
 
 /// The largest number of levels the patch-count buffer holds.
 pub const MAX_LEVELS: u32 = 16;

@@ -2,7 +2,7 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
+    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
@@ -142,6 +142,13 @@ fn light_patch_matches_shared_glsl() {
 }
 
 #[test]
+fn hisr_cut_header_matches_shared_glsl() {
+    for shader in ["hisr_cut.comp", "gather.frag"] {
+        check!(shader, HisrCutHeader, "HisrCutHeader", tiles: 16, [tiles => "tiles"]);
+    }
+}
+
+#[test]
 fn material_matches_shared_glsl() {
     check!("gbuffer.frag", MaterialGpu, "MaterialGpu", pad2: 4, [
         base_color => "base_color",
@@ -211,6 +218,7 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("PRESENT_VIEW_INDIRECT"), PRESENT_VIEW_INDIRECT as u32);
     assert_eq!(value("PRESENT_VIEW_HOST"), PRESENT_VIEW_HOST as u32);
     assert_eq!(value("LIGHT_SPOT"), LIGHT_SPOT as u32);
+    assert_eq!(value("HISR_CUT_OVERFLOW"), HISR_CUT_OVERFLOW);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
     assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {

@@ -137,6 +137,11 @@ struct RenderArgs {
     /// light patch is subdivided while its contribution could exceed tau * I.
     #[arg(long, default_value_t = D.light_tree.tau)]
     tau: f32,
+    /// HISR finds the traversal shared by each 2^K x 2^K-pixel tile once per
+    /// tile (pass hisr-cut); 0 traverses from the roots in every fragment.
+    /// Same image either way (up to float rounding).
+    #[arg(long, default_value_t = D.light_tree.hisr_tile_level)]
+    hisr_tile_level: u32,
     /// Light patches merge only when each child lies within this fraction of
     /// its distance to the light from the merged patch's plane.
     #[arg(long, default_value_t = D.light_tree.depth_threshold)]
@@ -446,6 +451,7 @@ fn render(args: RenderArgs) -> Result<()> {
             start_level: args.start_level,
             max_depth: args.max_depth,
             tau: args.tau,
+            hisr_tile_level: args.hisr_tile_level,
         },
         splat_threshold: args.splat_threshold,
         reference_chunk: args.reference_chunk,

@@ -2,7 +2,7 @@
 //! failure with a message that says what to change.
 
 use super::targets::target_list;
-use crate::settings::{Method, RenderSettings, MAX_LEVELS};
+use crate::settings::{Method, RenderSettings, HISR_MAX_TILE_LEVEL, MAX_LEVELS};
 use crate::vk::resources::texel_bytes;
 use crate::vk::Gpu;
 use anyhow::{bail, Result};
@@ -151,6 +151,11 @@ pub fn memory_estimate(s: &RenderSettings) -> u64 {
         } else {
             0
         }
+        + if s.method == Method::Hisr {
+            crate::methods::hisr::cut_bytes(s)
+        } else {
+            0
+        }
 }
 
 /// GPU memory of the multiresolution buffer: (L + 1) layers of illumination
@@ -246,6 +251,12 @@ pub fn check_ranges(s: &RenderSettings) -> Result<()> {
         bail!(
             "--start-level {} and --max-depth {max_depth} must satisfy start <= max <= log2(--rsm) = {top}",
             lt.start_level
+        );
+    }
+    if lt.hisr_tile_level > HISR_MAX_TILE_LEVEL {
+        bail!(
+            "--hisr-tile-level {}: tiles of more than 2^{HISR_MAX_TILE_LEVEL} pixels a side share too little; use 0 (off) to {HISR_MAX_TILE_LEVEL}",
+            lt.hisr_tile_level
         );
     }
     if !(lt.tau > 0.0 && lt.tau < 1.0) {

@@ -17,7 +17,7 @@ use crate::vk::barrier;
 use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -28,6 +28,9 @@ pub enum LightPatches {
     List = 0,
     /// A per-fragment traversal of the packed quadtree (HISR).
     Traversal = 1,
+    /// The same traversal, started from the fragment's tile's cut (HISR with
+    /// tiles, `hisr-cut`).
+    TiledTraversal = 2,
 }
 
 /// What fills the multiresolution buffer's patches: the gather or the splat.
@@ -41,15 +44,24 @@ pub struct GatherPass {
 }
 
 impl GatherPass {
-    /// `patches` is the light-space pass's buffer: the regular VPLs, Basic
-    /// ISR's list or HISR's packed tree. With `--stencil off` the pipeline has
-    /// no stencil test (measurement baseline).
+    /// `light` is the light-space pass: its buffer holds the regular VPLs,
+    /// Basic ISR's list or HISR's packed tree (and with
+    /// `LightPatches::TiledTraversal`, its tile cuts). With `--stencil off`
+    /// the pipeline has no stencil test (measurement baseline).
     pub fn new(
         setup: &Setup,
         m: &MultiresBuffer,
         source: LightPatches,
-        patches: &Buffer,
+        light: &dyn LightSpacePass,
     ) -> Result<Self> {
+        let patches = light.buffer();
+        // Bound in every case (the shader declares it); read only when tiled.
+        let cuts = match source {
+            LightPatches::TiledTraversal => light
+                .tile_cuts()
+                .ok_or_else(|| anyhow!("a tiled traversal needs the tile cuts"))?,
+            _ => patches,
+        };
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let stencil = setup.settings.multires.stencil;
         let pipeline = PassPipeline::graphics(
@@ -62,6 +74,7 @@ impl GatherPass {
                 Binding::storage("ChosenPatches", patches),
                 Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                 Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+                Binding::storage("HisrCut", cuts),
             ],
             GraphicsDesc {
                 name: "gather",
@@ -106,6 +119,10 @@ pub trait LightSpacePass {
     }
     /// HISR's packed light tree (read back by tests).
     fn packed_tree(&self) -> Option<&Buffer> {
+        None
+    }
+    /// HISR's per-tile cuts (`HisrCutHeader`, counts, entries).
+    fn tile_cuts(&self) -> Option<&Buffer> {
         None
     }
 }
@@ -244,18 +261,18 @@ pub struct MultiresMethod {
 
 impl MultiresMethod {
     /// `fill` makes the pass that fills the buffer's patches, given the
-    /// buffer and the light-space pass's buffer (if there is one).
+    /// buffer and the light-space pass (if there is one).
     pub fn new(
         setup: &Setup,
         light_pass: Option<Box<dyn LightSpacePass>>,
-        fill: impl FnOnce(&Setup, &MultiresBuffer, Option<&Buffer>) -> Result<Box<dyn FillPass>>,
+        fill: impl FnOnce(
+            &Setup,
+            &MultiresBuffer,
+            Option<&dyn LightSpacePass>,
+        ) -> Result<Box<dyn FillPass>>,
     ) -> Result<Self> {
         let multires = Multires::new(setup)?;
-        let fill = fill(
-            setup,
-            &multires.buffer,
-            light_pass.as_ref().map(|l| l.buffer()),
-        )?;
+        let fill = fill(setup, &multires.buffer, light_pass.as_deref())?;
         Ok(Self {
             multires,
             light_pass,

@@ -3,16 +3,28 @@
 //! subdividing light patches whose contribution could exceed tau. The
 //! traversal is in `shaders/gather.frag` (`traverse`, with the derivation of
 //! the bound) and reads the quadtree packed into one buffer by the pass
-//! below; this module makes the method and holds its constants.
+//! below, starting from its eye-space tile's shared cut (`hisr-cut`); this
+//! module makes the method and its passes and holds its constants.
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchList, PatchListPass};
-use crate::frame::Setup;
-use anyhow::{anyhow, Result};
+use super::gather::{
+    GatherPass, LightPatches, LightSpacePass, MultiresMethod, PatchList, PatchListPass,
+};
+use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::HisrCutHeader;
+use crate::passes::{ComputePass, INDIRECT_COMPUTE};
+use crate::settings::RenderSettings;
+use crate::vk::barrier;
+use crate::vk::pipeline::Binding;
+use crate::vk::profiler::Profiler;
+use crate::vk::Buffer;
+use anyhow::Result;
 use ash::vk;
+use gpu_allocator::MemoryLocation;
 
 /// Method `hisr`: pass `light-tree-pack` (`shaders/light_tree_pack.comp`)
-/// copies every node of the RSM quadtree into one buffer, root first, then
-/// the gather traverses it per fragment.
+/// copies every node of the RSM quadtree into one buffer, root first; with
+/// tiles (`--hisr-tile-level`), pass `hisr-cut` finds each eye-space tile's
+/// shared cut; then the gather traverses per fragment.
 pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     let r = setup.settings.rsm_resolution as u64;
     let nodes = (4 * r * r - 1) / 3;
@@ -28,15 +40,140 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
         nodes,
         extent,
     )?;
-    MultiresMethod::new(setup, Some(Box::new(pack)), |setup, m, tree| {
-        let tree = tree.ok_or_else(|| anyhow!("hisr gathers from its packed tree"))?;
-        Ok(Box::new(GatherPass::new(
-            setup,
-            m,
-            LightPatches::Traversal,
-            tree,
-        )?))
+    let cut = match setup.settings.light_tree.hisr_tile_level {
+        0 => None,
+        _ => Some(CutPass::new(setup, pack.buffer())?),
+    };
+    let source = match cut {
+        Some(_) => LightPatches::TiledTraversal,
+        None => LightPatches::Traversal,
+    };
+    let light = HisrLightPass { pack, cut };
+    MultiresMethod::new(setup, Some(Box::new(light)), move |setup, m, light| {
+        let light = light.expect("hisr has a light-space pass");
+        Ok(Box::new(GatherPass::new(setup, m, source, light)?))
     })
+}
+
+/// HISR's light-space passes: the packing, then (with tiles) the cut.
+struct HisrLightPass {
+    pack: PatchListPass,
+    cut: Option<CutPass>,
+}
+
+impl LightSpacePass for HisrLightPass {
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        self.pack.record(ctx, profiler);
+        if let Some(cut) = &self.cut {
+            cut.record(ctx, profiler);
+        }
+    }
+
+    fn buffer(&self) -> &Buffer {
+        self.pack.buffer()
+    }
+
+    fn packed_tree(&self) -> Option<&Buffer> {
+        self.pack.packed_tree()
+    }
+
+    fn tile_cuts(&self) -> Option<&Buffer> {
+        self.cut.as_ref().map(|c| &c.buffer)
+    }
+}
+
+/// The most entries a tile's cut holds; fewer when there are many tiles, so
+/// that the buffer stays under `CUT_BUFFER_BUDGET`. A tile whose cut does not
+/// fit traverses from the roots (the same image, slower).
+const CUT_CAPACITY: u64 = 2048;
+const CUT_BUFFER_BUDGET: u64 = 64 << 20;
+
+/// Tiles per row and column, tile level and entries per tile
+/// (`HisrCutHeader::tiles`) for `s`.
+pub fn cut_layout(s: &RenderSettings) -> [u32; 4] {
+    let k = s.light_tree.hisr_tile_level;
+    let (tx, ty) = (s.width.div_ceil(1 << k), s.height.div_ceil(1 << k));
+    let tiles = tx as u64 * ty as u64;
+    let capacity = (CUT_BUFFER_BUDGET / 4 / tiles).clamp(64, CUT_CAPACITY);
+    [tx, ty, k, capacity as u32]
+}
+
+/// Bytes of the cut buffer (0 without tiles).
+pub fn cut_bytes(s: &RenderSettings) -> u64 {
+    if s.light_tree.hisr_tile_level == 0 {
+        return 0;
+    }
+    let [tx, ty, _, capacity] = cut_layout(s);
+    let tiles = tx as u64 * ty as u64;
+    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * tiles * (1 + capacity as u64)
+}
+
+/// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
+/// one invocation per eye-space tile. Reads the G-buffer positions and the
+/// packed tree; writes the cut buffer (barriers in `record`).
+struct CutPass {
+    pass: ComputePass,
+    buffer: Buffer,
+    tiles: [u32; 4],
+}
+
+impl CutPass {
+    fn new(setup: &Setup, tree: &Buffer) -> Result<Self> {
+        let tiles = cut_layout(setup.settings);
+        let buffer = Buffer::new(
+            setup.gpu,
+            "hisr-cut",
+            cut_bytes(setup.settings),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuOnly,
+        )?;
+        let (t, s) = (setup.targets, setup.samplers);
+        let bindings = vec![
+            Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+            Binding::storage("LightTree", tree),
+            Binding::storage("HisrCut", &buffer),
+        ];
+        let pass = ComputePass::new(setup, "hisr-cut", "hisr_cut.comp", &[bindings], 16, &[])?;
+        Ok(Self {
+            pass,
+            buffer,
+            tiles,
+        })
+    }
+
+    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let readers = vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY;
+        profiler.pass(gpu, cmd, "hisr-cut", INDIRECT_COMPUTE, || {
+            // The packed tree, just written, is read here; the previous
+            // gather (of this frame's previous light view or the previous
+            // frame) and readback read the cuts before they are overwritten.
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER | readers,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            let [tx, ty, ..] = self.tiles;
+            let push: Vec<u8> = bytemuck::cast_slice(&self.tiles).to_vec();
+            // One invocation per tile.
+            let extent = vk::Extent2D {
+                width: tx,
+                height: ty,
+            };
+            self.pass.dispatch(ctx, 0, &push, extent);
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                readers,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
+            );
+        });
+    }
 }
 
 /// T at the finest level for `tau` given as a fraction of the light's peak

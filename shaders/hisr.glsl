@@ -1,0 +1,29 @@
+// HISR's quadtree addressing and subdivision test (docs/algorithm.md section
+// 4), shared by the per-fragment traversal (gather.frag) and the per-tile cut
+// (hisr_cut.comp), which must decide exactly alike. Needs frame.glsl,
+// light_types.glsl and shared.glsl.
+#ifndef HISR_GLSL
+#define HISR_GLSL
+
+// Node (x, y) of depth z (2^z x 2^z patches) in the packed tree
+// (light_tree_pack.comp): depth-major from the root, row-major inside.
+int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
+
+// The node's squared reach: patch j splits for receiver i iff it is above the
+// max depth and |V_ij|^2 <= hisr_reach (gather.frag has the derivation; the
+// per-level factor 4^k, k levels above the finest RSM texel). Invalid patches
+// are held to tau * HISR_INVALID_TAU_SCALE.
+float hisr_reach(LightPatch lp, ivec3 node) {
+    int mip = run.light_levels.w - node.z;
+    float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.light_tree.x);
+    if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
+    return reach;
+}
+
+// A cut entry (HisrCutHeader): x in bits 0-11, y in 12-23, depth in 24-27
+// (the tree is at most 12 deep).
+uint cut_entry(ivec3 node) { return uint(node.x) | (uint(node.y) << 12) | (uint(node.z) << 24); }
+
+ivec3 cut_node(uint entry) { return ivec3(entry & 0xfffu, (entry >> 12) & 0xfffu, (entry >> 24) & 0xfu); }
+
+#endif

@@ -1,0 +1,118 @@
+#version 460
+// Pass `hisr-cut` (HISR, docs/algorithm.md section 4.4): one invocation per
+// eye-space tile of 2^K x 2^K pixels finds the part of the light-tree
+// traversal that every receiver in the tile would make alike, so that the
+// gather's fragments start from a shared, coherent list instead of each
+// walking the tree from the roots.
+//
+// Every receiver of the tile (a patch mean of levels <= K: a mean of the
+// tile's G-buffer positions) lies in the box of the tile's positions. For a
+// node with squared reach R (hisr.glsl), and the box's nearest and farthest
+// squared distances n <= |V_ij|^2 <= f:
+//   f <= R (and above the max depth): every receiver splits it; its children
+//     are examined here;
+//   n > R, or at the max depth: no receiver splits it; entry "evaluate";
+//   otherwise receivers disagree; entry "traverse", walked per fragment.
+// So each fragment makes the same decisions as a traversal from the roots.
+// The box is padded by a little more than float rounding so that a receiver
+// on its surface is decided alike too.
+//
+// One invocation per tile, depth-first without a stack, entries written in
+// traversal order (so the gather's sums come in the same order every
+// frame). A tile whose list does not fit is marked HISR_CUT_OVERFLOW and its
+// fragments traverse from the roots (same result, slower).
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+#include "light_types.glsl"
+#include "hisr.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
+layout(set = 1, binding = 1, std430) readonly buffer LightTree {
+    uint node_count;
+    uint pad0, pad1, pad2;
+    LightPatch nodes[];  // the packed tree (light_tree_pack.comp)
+};
+layout(set = 1, binding = 2, std430) writeonly buffer HisrCut {
+    HisrCutHeader header;
+    uint cut[];  // counts[tiles], then capacity entries per tile
+};
+
+layout(push_constant) uniform Push { uvec4 tiles; };  // as HisrCutHeader.tiles
+
+// The box of tile `tile`'s positions, padded (see above); lo.x > hi.x if it
+// has none.
+void tile_box(ivec2 tile, out vec3 lo, out vec3 hi) {
+    int side = 1 << tiles.z;
+    ivec2 origin = tile * side;
+    ivec2 end = min(origin + side, ivec2(run.size.xy));
+    lo = vec3(3.0e38);
+    hi = vec3(-3.0e38);
+    for (int y = origin.y; y < end.y; ++y) {
+        for (int x = origin.x; x < end.x; ++x) {
+            vec4 p = texelFetch(gbuffer_position, ivec2(x, y), 0);
+            if (p.w <= 0.0) continue;
+            lo = min(lo, p.xyz);
+            hi = max(hi, p.xyz);
+        }
+    }
+    vec3 m = max(abs(lo), abs(hi));
+    float pad = 1e-5 * max(m.x, max(m.y, m.z)) + 1e-4 * length(max(hi - lo, vec3(0.0)));
+    lo -= pad;
+    hi += pad;
+}
+
+void main() {
+    ivec2 tile = ivec2(gl_GlobalInvocationID.xy);
+    if (tile == ivec2(0)) header.tiles = tiles;
+    if (any(greaterThanEqual(tile, ivec2(tiles.xy)))) return;
+    uint t = uint(tile.y) * tiles.x + uint(tile.x);
+    uint base = tiles.x * tiles.y + t * tiles.w;
+    vec3 lo, hi;
+    tile_box(tile, lo, hi);
+    if (lo.x > hi.x) {  // no geometry: no receivers
+        cut[t] = 0u;
+        return;
+    }
+    int start = run.light_levels.x;
+    int max_depth = run.light_levels.y;
+    int side = 1 << start;
+    uint evaluate = 0u, traverse = 0u;
+    // Depth-first from each start node, without a stack (as gather.frag's
+    // traverse_from), so the entries come in the same order every frame.
+    for (int r = 0; r < side * side; ++r) {
+        ivec3 root = ivec3(r % side, r / side, start);
+        ivec3 node = root;
+        for (;;) {
+            LightPatch lp = nodes[node_index(node)];
+            if (lp.position_area.w > 0.0) {  // else: saw nothing
+                bool deeper = node.z < max_depth;
+                float reach = deeper ? hisr_reach(lp, node) : -1.0;
+                vec3 p = lp.position_area.xyz;
+                vec3 far = max(abs(p - lo), abs(p - hi));
+                if (deeper && dot(far, far) <= reach) {
+                    node = ivec3(2 * node.xy, node.z + 1);
+                    continue;
+                }
+                vec3 near = max(max(lo - p, p - hi), vec3(0.0));
+                bool disagree = deeper && dot(near, near) <= reach;
+                // Evaluate entries from the front of the range, traverse
+                // entries from the back; they must not meet.
+                if (evaluate + traverse < tiles.w) {
+                    uint at = disagree ? base + tiles.w - 1u - traverse : base + evaluate;
+                    cut[at] = cut_entry(node);
+                }
+                if (disagree) {
+                    ++traverse;
+                } else {
+                    ++evaluate;
+                }
+            }
+            // Up past the last children (1, 1), then on to the next sibling.
+            while (node.z > root.z && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
+            if (node.z == root.z) break;
+            node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
+        }
+    }
+    cut[t] = evaluate + traverse > tiles.w ? HISR_CUT_OVERFLOW : evaluate | (traverse << 16);
+}
