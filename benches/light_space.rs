@@ -2,8 +2,10 @@
 //! ISR and multires-gather with 256, 1024 and 4096 VPLs, measured in one run
 //! on the built-in Cornell box at 512x512 with a 256x256 RSM. The reference is
 //! the dense gather of every RSM texel (65,536 VPLs) through the same
-//! eye-space patches, so the error is the light-space choice alone.
-//! Writes `target/bench/light_space.json`.
+//! eye-space patches, so the error is the light-space choice alone. Then the
+//! issue-12 goals as ratios from the same run: HISR's time at Basic ISR's
+//! error and at 4096 VPLs' error, against theirs. `ISR_BENCH_SIZE=256` for a
+//! quicker run. Writes `target/bench/light_space.json`.
 
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
@@ -75,7 +77,10 @@ fn main() -> anyhow::Result<()> {
         &with(Method::Isr, 256, Default::default()),
         3,
     )?);
-    for tau in [0.5, 0.2, 0.05, 0.01] {
+    // The HISR curve (tiles of 16x16 pixels, the default); one point
+    // without tiles (every fragment traverses from the roots) for comparison.
+    let hisr_taus = [0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005];
+    for tau in hisr_taus {
         let lt = LightTreeSettings {
             tau,
             ..Default::default()
@@ -84,14 +89,41 @@ fn main() -> anyhow::Result<()> {
             &gpu,
             &format!("hisr tau {tau}"),
             &with(Method::Hisr, 256, lt),
-            2,
+            3,
         )?);
     }
+    // Below 4096 VPLs' error HISR needs patches finer than theirs (depth 6 is
+    // their level): depth 7.
+    let deep_taus = [0.02, 0.01, 0.005];
+    for tau in deep_taus {
+        let lt = LightTreeSettings {
+            tau,
+            max_depth: Some(7),
+            ..Default::default()
+        };
+        runs.push(run(
+            &gpu,
+            &format!("hisr tau {tau}, depth 7"),
+            &with(Method::Hisr, 256, lt),
+            3,
+        )?);
+    }
+    let no_tiles = LightTreeSettings {
+        hisr_tile_level: 0,
+        ..Default::default()
+    };
+    runs.push(run(
+        &gpu,
+        "hisr tau 0.05, no tiles",
+        &with(Method::Hisr, 256, no_tiles),
+        3,
+    )?);
     let mut rows = Vec::new();
     println!(
-        "{:<22} {:>12} {:>18} {:>14}",
+        "{:<24} {:>12} {:>18} {:>14}",
         "method", "indirect ms", "patches/eye patch", "rel. RMSE"
     );
+    let mut points = Vec::new(); // (label, ms, error)
     for r in &runs {
         let (mut err, mut norm) = (0.0f64, 0.0f64);
         for (a, b) in r.indirect.iter().zip(&reference.indirect) {
@@ -102,10 +134,44 @@ fn main() -> anyhow::Result<()> {
         }
         let rmse = (err / norm).sqrt();
         println!(
-            "{:<22} {:>12.1} {:>18.1} {:>14.4}",
+            "{:<24} {:>12.1} {:>18.1} {:>14.4}",
             r.label, r.indirect_ms, r.patches_per_eye_patch, rmse
         );
         rows.push(json!({"method": r.label, "indirect_ms": r.indirect_ms, "patches_per_eye_patch": r.patches_per_eye_patch, "relative_rmse": rmse}));
+        points.push((r.label.clone(), r.indirect_ms, rmse));
+    }
+    // The issue's goals as ratios from this run: HISR's time at another
+    // method's error, interpolated on HISR's front (the settings no other
+    // HISR setting beats in both time and error; log time against log error
+    // between the two that bracket it).
+    let hisr: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.0.starts_with("hisr tau") && !p.0.ends_with("no tiles"))
+        .map(|p| (p.1, p.2))
+        .collect();
+    let mut curve: Vec<(f64, f64)> = hisr
+        .iter()
+        .filter(|a| !hisr.iter().any(|b| b.0 < a.0 && b.1 < a.1))
+        .copied()
+        .collect();
+    curve.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut goals = Vec::new();
+    for (target, want) in [("isr (base 64)", 1.0), ("multires-gather 4096", 4.0)] {
+        let Some(&(_, ms, error)) = points.iter().find(|p| p.0 == target) else {
+            continue;
+        };
+        let line = match hisr_time_at(&curve, error) {
+            Some(hisr_ms) => format!(
+                "at {target}'s error {error:.4}: hisr {hisr_ms:.1} ms, {target} {ms:.1} ms: {:.2}x faster (goal {want}x)",
+                ms / hisr_ms
+            ),
+            None => format!(
+                "at {target}'s error {error:.4}: not reached by the hisr curve (lowest error {:.4})",
+                curve.iter().map(|c| c.1).fold(f64::INFINITY, f64::min)
+            ),
+        };
+        println!("{line}");
+        goals.push(line);
     }
     println!("reference: {} ms indirect", reference.indirect_ms);
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench");
@@ -113,8 +179,25 @@ fn main() -> anyhow::Result<()> {
     std::fs::write(
         dir.join("light_space.json"),
         serde_json::to_string_pretty(
-            &json!({"device": gpu.info.name, "width": size, "height": size, "rsm": 256, "runs": rows}),
+            &json!({"device": gpu.info.name, "width": size, "height": size, "rsm": 256, "runs": rows, "goals": goals}),
         )?,
     )?;
     Ok(())
+}
+
+/// HISR's time at `error` on `curve` ((ms, error) by falling error), log-log
+/// interpolated between the two points that bracket it.
+fn hisr_time_at(curve: &[(f64, f64)], error: f64) -> Option<f64> {
+    curve.windows(2).find_map(|w| {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        let (lo, hi) = (e0.min(e1), e0.max(e1));
+        if !(lo..=hi).contains(&error) {
+            return None;
+        }
+        if e0 == e1 {
+            return Some(t0.min(t1));
+        }
+        let f = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
+        Some((t0.ln() + f * (t1.ln() - t0.ln())).exp())
+    })
 }
