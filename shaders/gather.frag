@@ -12,8 +12,6 @@
 // With the stencil off (a measurement baseline) every texel is shaded and
 // non-patches are masked afterwards.
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_ballot : require
-#extension GL_KHR_shader_subgroup_vote : require
 #include "frame.glsl"
 #include "light_types.glsl"
 #include "vpl.glsl"
@@ -149,23 +147,17 @@ void walk_cut(vec3 xi, vec3 ni, uint t) {
 }
 
 // From the cut of the tile holding texel p of this level. Levels coarser than
-// the tile, and tiles whose cut overflowed, traverse from the roots. When a
-// subgroup's lanes share their tile (the common case: neighbouring texels of
-// one layer), the tile is made subgroup-uniform (subgroupBroadcastFirst), so
-// its entries and the nodes they name are loaded once for all lanes rather
-// than once per lane.
+// the tile traverse from the roots. (Making the tile subgroup-uniform where
+// the lanes share it, so that each entry is one load for all lanes, was no
+// faster on lavapipe: docs/algorithm.md section 4.4.)
 void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
     int k = int(cut_header.tiles.z);
-    uint mine = HISR_CUT_OVERFLOW;
+    uint t = HISR_CUT_OVERFLOW;
     if (level <= k) {
         ivec2 tile = p >> (k - level);
-        mine = uint(tile.y) * cut_header.tiles.x + uint(tile.x);
+        t = uint(tile.y) * cut_header.tiles.x + uint(tile.x);
     }
-    if (subgroupAllEqual(mine)) {
-        walk_cut(xi, ni, subgroupBroadcastFirst(mine));
-    } else {
-        walk_cut(xi, ni, mine);
-    }
+    walk_cut(xi, ni, t);
 }
 
 void main() {
