@@ -34,7 +34,10 @@ layout(set = 1, binding = 9, rgba32f) writeonly uniform image2D dst_min;
 layout(set = 1, binding = 10, rgba32f) writeonly uniform image2D dst_max;
 layout(set = 1, binding = 11, r32ui) writeonly uniform uimage2D dst_flags;
 
-layout(push_constant) uniform Push { int level; };
+// Level 1 (reads the G-buffer) and the levels above (read level l - 1) are
+// separate pipelines: CPU drivers run both sides of a branch under a lane
+// mask, so a branch on `level` would cost every texel the reads of both.
+layout(constant_id = 0) const bool LEVEL_ONE = false;
 
 // Level 0 as the other passes read it (levels above come from src_* here).
 #define GEO_LEVEL0_ONLY
@@ -74,16 +77,16 @@ void coarser_level(ivec2 p) {
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
     for (int i = 0; i < 4; ++i) {
         ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
-        vec4 cn = level == 1 ? level0_normal(c) : imageLoad(src_normal, c);
-        mean += cn.w * (level == 1 ? level0_mean(c) : imageLoad(src_mean, c));
+        vec4 cn = LEVEL_ONE ? level0_normal(c) : imageLoad(src_normal, c);
+        mean += cn.w * (LEVEL_ONE ? level0_mean(c) : imageLoad(src_mean, c));
         normal += cn.w * cn.xyz;
         coverage += cn.w;
-        if (level >= 2) {
+        if (!LEVEL_ONE) {
             lo = min(lo, imageLoad(src_min, c));
             hi = max(hi, imageLoad(src_max, c));
         }
     }
-    if (level == 1) level_one_ranges(p, lo, hi);
+    if (LEVEL_ONE) level_one_ranges(p, lo, hi);
     uint flags = 0u;
     if (coverage > 0.0) {
         mean /= coverage;
@@ -95,7 +98,7 @@ void coarser_level(ivec2 p) {
         bool split = (flags & GEO_SMOOTH) == 0u;
         ivec2 below = imageSize(src_flags);
         // Level 0 never splits: level 1 has no finer splits to look at.
-        for (int dy = -1; dy <= 2 && !split && level >= 2; ++dy) {
+        for (int dy = -1; dy <= 2 && !split && !LEVEL_ONE; ++dy) {
             for (int dx = -1; dx <= 2; ++dx) {
                 ivec2 q = 2 * p + ivec2(dx, dy);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, below))) continue;

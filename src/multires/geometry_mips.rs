@@ -11,7 +11,16 @@ use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
-pub struct GeometryMipsPass(ComputePass);
+/// Level 1 and the levels above are separate pipelines (`geometry_mips.comp`'s
+/// specialisation constant LEVEL_ONE): CPU drivers execute every branch under
+/// a lane mask, so one pipeline would run the reads of both for every texel.
+pub struct GeometryMipsPass {
+    level_one: ComputePass,
+    /// Levels 2..=L, one descriptor set each (none with L = 1).
+    above: Option<ComputePass>,
+}
+
+const LEVEL_ONE: u32 = 0;
 
 /// Shader names of the five chains' source (`src_*`) and destination (`dst_*`)
 /// bindings, in `MultiresBuffer::geometry_images` order.
@@ -25,7 +34,7 @@ impl GeometryMipsPass {
         // Every chain holds levels 1..=L (mip m is level m + 1; level 0 is
         // the G-buffer). Level 1 reads the G-buffer, so its source bindings
         // are unused and point at a mip it does not write.
-        let variants: Vec<Vec<Binding>> = (1..=m.levels as usize)
+        let mut variants: Vec<Vec<Binding>> = (1..=m.levels as usize)
             .map(|l| {
                 let mut b = vec![
                     Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
@@ -51,14 +60,25 @@ impl GeometryMipsPass {
                 b
             })
             .collect();
-        Ok(Self(ComputePass::new(
-            setup,
-            "geometry-mips",
-            "geometry_mips.comp",
-            &variants,
-            4,
-            &[],
-        )?))
+        let above = variants.split_off(1);
+        let pass = |variants: &[Vec<Binding>], level_one: bool| {
+            ComputePass::new(
+                setup,
+                "geometry-mips",
+                "geometry_mips.comp",
+                variants,
+                0,
+                &[(LEVEL_ONE, level_one as i32)],
+            )
+        };
+        Ok(Self {
+            level_one: pass(&variants, true)?,
+            above: if above.is_empty() {
+                None
+            } else {
+                Some(pass(&above, false)?)
+            },
+        })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -76,9 +96,12 @@ impl GeometryMipsPass {
                 if level > 1 {
                     barrier::compute_to_compute(gpu, cmd);
                 }
-                let push = (level as i32).to_ne_bytes();
-                self.0
-                    .dispatch(ctx, level as usize - 1, &push, m.level_extent(level));
+                let extent = m.level_extent(level);
+                match (level, &self.above) {
+                    (1, _) => self.level_one.dispatch(ctx, 0, &[], extent),
+                    (_, Some(above)) => above.dispatch(ctx, level as usize - 2, &[], extent),
+                    (_, None) => unreachable!("levels above 1 have their pipeline"),
+                }
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });
