@@ -11,16 +11,17 @@ use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
-/// Level 1 and the levels above are separate pipelines (`geometry_mips.comp`'s
-/// specialisation constant LEVEL_ONE): CPU drivers execute every branch under
-/// a lane mask, so one pipeline would run the reads of both for every texel.
+/// Level 1, level 2 and the levels above are separate pipelines
+/// (`geometry_mips.comp`'s specialisation constant LEVEL): CPU drivers execute
+/// every branch under a lane mask, so one pipeline would run the reads and
+/// stores of all three for every texel.
 pub struct GeometryMipsPass {
-    level_one: ComputePass,
-    /// Levels 2..=L, one descriptor set each (none with L = 1).
-    above: Option<ComputePass>,
+    /// Index 0: level 1; 1: level 2 (L >= 2); 2: levels 3..=L, one descriptor
+    /// set each (L >= 3).
+    pipelines: Vec<ComputePass>,
 }
 
-const LEVEL_ONE: u32 = 0;
+const LEVEL: u32 = 0;
 
 /// Shader names of the five chains' source (`src_*`) and destination (`dst_*`)
 /// bindings, in `MultiresBuffer::geometry_images` order.
@@ -31,54 +32,46 @@ impl GeometryMipsPass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
         let (t, s) = (setup.targets, setup.samplers);
         let images = m.geometry_images();
-        // Every chain holds levels 1..=L (mip m is level m + 1; level 0 is
-        // the G-buffer). Level 1 reads the G-buffer, so its source bindings
-        // are unused and point at a mip it does not write.
-        let mut variants: Vec<Vec<Binding>> = (1..=m.levels as usize)
-            .map(|l| {
-                let mut b = vec![
-                    Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
-                    Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
-                ];
-                let dst = vec![l - 1; images.len()];
-                let unused = if l == 1 { m.levels as usize - 1 } else { l - 2 };
-                let src = vec![unused; images.len()];
-                b.extend(
-                    images
-                        .iter()
-                        .zip(SOURCES)
-                        .zip(&src)
-                        .map(|((i, name), &mip)| Binding::storage_image(name, i.mip_views[mip])),
-                );
-                b.extend(
-                    images
-                        .iter()
-                        .zip(DESTINATIONS)
-                        .zip(&dst)
-                        .map(|((i, name), &mip)| Binding::storage_image(name, i.mip_views[mip])),
-                );
-                b
-            })
-            .collect();
-        let above = variants.split_off(1);
-        let pass = |variants: &[Vec<Binding>], level_one: bool| {
+        let levels = m.levels as usize;
+        // Mean, normal and flags hold levels 1..=L (mip m is level m + 1;
+        // level 0 is the G-buffer); the ranges hold levels 2..=L (mip m is
+        // level m + 2; levels 1 and 2 read the G-buffer). Bindings a level
+        // does not use point at a mip it does not write (the last one).
+        let mip_of = |image: usize, level: usize| {
+            let first = if image == 2 || image == 3 { 2 } else { 1 };
+            let last = images[image].mip_views.len() - 1;
+            level.checked_sub(first).unwrap_or(last)
+        };
+        let bindings = |l: usize| {
+            let mut b = vec![
+                Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+            ];
+            for (names, level) in [(SOURCES, l - 1), (DESTINATIONS, l)] {
+                b.extend(images.iter().zip(names).enumerate().map(|(k, (i, name))| {
+                    Binding::storage_image(name, i.mip_views[mip_of(k, level)])
+                }));
+            }
+            b
+        };
+        let pass = |kind: i32, variants: Vec<Vec<Binding>>| {
             ComputePass::new(
                 setup,
                 "geometry-mips",
                 "geometry_mips.comp",
-                variants,
+                &variants,
                 0,
-                &[(LEVEL_ONE, level_one as i32)],
+                &[(LEVEL, kind)],
             )
         };
-        Ok(Self {
-            level_one: pass(&variants, true)?,
-            above: if above.is_empty() {
-                None
-            } else {
-                Some(pass(&above, false)?)
-            },
-        })
+        let mut pipelines = vec![pass(1, vec![bindings(1)])?];
+        if levels >= 2 {
+            pipelines.push(pass(2, vec![bindings(2)])?);
+        }
+        if levels >= 3 {
+            pipelines.push(pass(3, (3..=levels).map(bindings).collect())?);
+        }
+        Ok(Self { pipelines })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -92,16 +85,15 @@ impl GeometryMipsPass {
                 Use::DISCARD_AFTER_READERS,
                 Use::COMPUTE_STORAGE,
             );
-            for level in 1..=m.levels {
+            for level in 1..=m.levels as usize {
                 if level > 1 {
                     barrier::compute_to_compute(gpu, cmd);
                 }
-                let extent = m.level_extent(level);
-                match (level, &self.above) {
-                    (1, _) => self.level_one.dispatch(ctx, 0, &[], extent),
-                    (_, Some(above)) => above.dispatch(ctx, level as usize - 2, &[], extent),
-                    (_, None) => unreachable!("levels above 1 have their pipeline"),
-                }
+                let (pipeline, set) = match level {
+                    1 | 2 => (level - 1, 0),
+                    _ => (2, level - 3),
+                };
+                self.pipelines[pipeline].dispatch(ctx, set, &[], m.level_extent(level as u32));
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });
