@@ -8,14 +8,10 @@
 //
 // Discontinuities on texel borders: every texel's range covers its footprint
 // plus a one-pixel ring, so an edge lying exactly on a border is seen by the
-// texels on both sides; level 0 needs none (it is always smooth). Levels 1 and
-// 2 take their ranges straight from the G-buffer's (2^l + 2)^2 pixels; levels
-// l >= 3 merge the ranges of their children, which levels >= 2 store (the
-// range chains geo_min and geo_max start at level 2). The union of the
-// children's footprints and rings is the texel's footprint and ring, so both
-// give the same ranges. Image stores cost CPU drivers far more than fetches:
-// level 1 (a quarter of the pixel count) storing its ranges cost about as
-// much as reading 36 G-buffer pixels per texel of level 2.
+// texels on both sides; level 0 needs none (it is always smooth). Level 1
+// takes its ranges straight from the G-buffer's 4x4 pixels (its 2x2 children
+// and their ring), each level above merges its children's ranges (the union
+// of their footprints and rings is its footprint and ring).
 //
 // 2:1 balance: a texel splits if it is not smooth, or if any texel of level
 // l - 1 in the 4x4 block around its children (its children and the ring of
@@ -27,24 +23,23 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
-// Level l - 1 (unused at level 1, which reads the G-buffer; the ranges are
-// unused below level 3).
+// Level l - 1 (unused at level 1, which reads the G-buffer).
 layout(set = 1, binding = 2, rgba32f) readonly uniform image2D src_mean;    // xyz: mean position; w: mean view depth
 layout(set = 1, binding = 3, rgba32f) readonly uniform image2D src_normal;  // xyz: mean normal (unit); w: coverage
 layout(set = 1, binding = 4, rgba32f) readonly uniform image2D src_min;     // x: min depth; yzw: min normal components
 layout(set = 1, binding = 5, rgba32f) readonly uniform image2D src_max;     // x: max depth; yzw: max normal components
 layout(set = 1, binding = 6, r32ui) readonly uniform uimage2D src_flags;
-// Level l (the ranges unused at level 1).
+// Level l.
 layout(set = 1, binding = 7, rgba32f) writeonly uniform image2D dst_mean;
 layout(set = 1, binding = 8, rgba32f) writeonly uniform image2D dst_normal;
 layout(set = 1, binding = 9, rgba32f) writeonly uniform image2D dst_min;
 layout(set = 1, binding = 10, rgba32f) writeonly uniform image2D dst_max;
 layout(set = 1, binding = 11, r32ui) writeonly uniform uimage2D dst_flags;
 
-// Level 1, level 2 and the levels above are separate pipelines: CPU drivers
-// run both sides of a branch under a lane mask, so a branch on the level
-// would cost every texel the reads and stores of all three.
-layout(constant_id = 0) const int LEVEL = 3;  // 1, 2, or 3 for every level >= 3
+// Level 1 (reads the G-buffer) and the levels above (read level l - 1) are
+// separate pipelines: CPU drivers run both sides of a branch under a lane
+// mask, so a branch on the level would cost every texel the reads of both.
+layout(constant_id = 0) const bool LEVEL_ONE = false;
 
 // Level 0 as the other passes read it (levels above come from src_* here).
 #define GEO_LEVEL0_ONLY
@@ -58,18 +53,16 @@ bool smooth_ranges(vec4 lo, vec4 hi) {
     return depth_ok && normal_ok;
 }
 
-// The depth and normal ranges of texel p of level l <= 2 (LEVEL is l):
-// straight from the G-buffer's pixels with geometry among its (2^l + 2)^2
-// pixels (footprint and ring). At level 1 also the sums over the 2x2
-// children. Each pixel is fetched once and unconditionally (clamped, then
-// masked): fetches under a condition cost CPU drivers as much as taken ones,
-// and the children's fetches are the same as the block's inner 2x2.
-void gbuffer_block(ivec2 p, inout vec4 mean, inout vec3 normal, inout float coverage, inout vec4 lo, inout vec4 hi) {
+// Level 1 from the G-buffer's 4x4 pixels around texel p (its 2x2 children
+// and their one-pixel ring): the children's sums and the ranges over the
+// pixels with geometry. Each pixel is fetched once and unconditionally
+// (clamped, then masked): fetches under a condition cost CPU drivers as much
+// as taken ones, and the children's fetches are the block's inner 2x2.
+void level_one(ivec2 p, inout vec4 mean, inout vec3 normal, inout float coverage, inout vec4 lo, inout vec4 hi) {
     ivec2 size = ivec2(run.size.xy);
-    const int side = 1 << LEVEL;
-    [[unroll]] for (int dy = -1; dy <= side; ++dy) {
-        [[unroll]] for (int dx = -1; dx <= side; ++dx) {
-            ivec2 q = side * p + ivec2(dx, dy);
+    [[unroll]] for (int dy = -1; dy <= 2; ++dy) {
+        [[unroll]] for (int dx = -1; dx <= 2; ++dx) {
+            ivec2 q = 2 * p + ivec2(dx, dy);
             bool inside = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size));
             ivec2 qc = clamp(q, ivec2(0), size - 1);
             vec4 qp = texelFetch(gbuffer_position, qc, 0);
@@ -78,9 +71,9 @@ void gbuffer_block(ivec2 p, inout vec4 mean, inout vec3 normal, inout float cove
                 lo = min(lo, vec4(qp.w, qn));
                 hi = max(hi, vec4(qp.w, qn));
             }
-            // Level 1's children (always inside: qc = q), in the order of
-            // the levels above; the compiler merges these fetches with the above.
-            if (LEVEL == 1 && dx >= 0 && dx <= 1 && dy >= 0 && dy <= 1) {
+            // The children (always inside: qc = q), in the order of the
+            // levels above; the compiler merges these fetches with the above.
+            if (dx >= 0 && dx <= 1 && dy >= 0 && dy <= 1) {
                 vec4 cn = level0_normal(qc);
                 mean += cn.w * level0_mean(qc);
                 normal += cn.w * cn.xyz;
@@ -95,18 +88,17 @@ void coarser_level(ivec2 p) {
     vec3 normal = vec3(0.0);
     float coverage = 0.0;
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
-    if (LEVEL <= 2) gbuffer_block(p, mean, normal, coverage, lo, hi);
-    if (LEVEL >= 2) {
+    if (LEVEL_ONE) {
+        level_one(p, mean, normal, coverage, lo, hi);
+    } else {
         for (int i = 0; i < 4; ++i) {
             ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
             vec4 cn = imageLoad(src_normal, c);
             mean += cn.w * imageLoad(src_mean, c);
             normal += cn.w * cn.xyz;
             coverage += cn.w;
-            if (LEVEL >= 3) {
-                lo = min(lo, imageLoad(src_min, c));
-                hi = max(hi, imageLoad(src_max, c));
-            }
+            lo = min(lo, imageLoad(src_min, c));
+            hi = max(hi, imageLoad(src_max, c));
         }
     }
     uint flags = 0u;
@@ -120,7 +112,7 @@ void coarser_level(ivec2 p) {
         bool split = (flags & GEO_SMOOTH) == 0u;
         ivec2 below = imageSize(src_flags);
         // Level 0 never splits: level 1 has no finer splits to look at.
-        for (int dy = -1; dy <= 2 && !split && LEVEL >= 2; ++dy) {
+        for (int dy = -1; dy <= 2 && !split && !LEVEL_ONE; ++dy) {
             for (int dx = -1; dx <= 2; ++dx) {
                 ivec2 q = 2 * p + ivec2(dx, dy);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, below))) continue;
@@ -134,11 +126,8 @@ void coarser_level(ivec2 p) {
     }
     imageStore(dst_mean, p, mean);
     imageStore(dst_normal, p, vec4(normal, coverage * 0.25));
-    // Level 1's ranges are not stored: level 2 reads the G-buffer.
-    if (LEVEL >= 2) {
-        imageStore(dst_min, p, lo);
-        imageStore(dst_max, p, hi);
-    }
+    imageStore(dst_min, p, lo);
+    imageStore(dst_max, p, hi);
     imageStore(dst_flags, p, uvec4(flags));
 }
 

@@ -11,17 +11,16 @@ use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
-/// Level 1, level 2 and the levels above are separate pipelines
-/// (`geometry_mips.comp`'s specialisation constant LEVEL): CPU drivers execute
-/// every branch under a lane mask, so one pipeline would run the reads and
-/// stores of all three for every texel.
+/// Level 1 and the levels above are separate pipelines (`geometry_mips.comp`'s
+/// specialisation constant LEVEL_ONE): CPU drivers execute every branch under
+/// a lane mask, so one pipeline would run the reads of both for every texel.
 pub struct GeometryMipsPass {
-    /// Index 0: level 1; 1: level 2 (L >= 2); 2: levels 3..=L, one descriptor
-    /// set each (L >= 3).
-    pipelines: Vec<ComputePass>,
+    level_one: ComputePass,
+    /// Levels 2..=L, one descriptor set each (none with L = 1).
+    above: Option<ComputePass>,
 }
 
-const LEVEL: u32 = 0;
+const LEVEL_ONE: u32 = 0;
 
 /// Shader names of the five chains' source (`src_*`) and destination (`dst_*`)
 /// bindings, in `MultiresBuffer::geometry_images` order.
@@ -33,45 +32,42 @@ impl GeometryMipsPass {
         let (t, s) = (setup.targets, setup.samplers);
         let images = m.geometry_images();
         let levels = m.levels as usize;
-        // Mean, normal and flags hold levels 1..=L (mip m is level m + 1;
-        // level 0 is the G-buffer); the ranges hold levels 2..=L (mip m is
-        // level m + 2; levels 1 and 2 read the G-buffer). Bindings a level
-        // does not use point at a mip it does not write (the last one).
-        let mip_of = |image: usize, level: usize| {
-            let first = if image == 2 || image == 3 { 2 } else { 1 };
-            let last = images[image].mip_views.len() - 1;
-            level.checked_sub(first).unwrap_or(last)
-        };
+        // Every chain holds levels 1..=L (mip m is level m + 1; level 0 is
+        // the G-buffer). Level 1 reads the G-buffer, so its source bindings
+        // are unused and point at a mip it does not write (the last one).
+        let mip_of = |level: usize| level.checked_sub(1).unwrap_or(levels - 1);
         let bindings = |l: usize| {
             let mut b = vec![
                 Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                 Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
             ];
             for (names, level) in [(SOURCES, l - 1), (DESTINATIONS, l)] {
-                b.extend(images.iter().zip(names).enumerate().map(|(k, (i, name))| {
-                    Binding::storage_image(name, i.mip_views[mip_of(k, level)])
-                }));
+                b.extend(
+                    images
+                        .iter()
+                        .zip(names)
+                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[mip_of(level)])),
+                );
             }
             b
         };
-        let pass = |kind: i32, variants: Vec<Vec<Binding>>| {
+        let pass = |level_one: bool, variants: Vec<Vec<Binding>>| {
             ComputePass::new(
                 setup,
                 "geometry-mips",
                 "geometry_mips.comp",
                 &variants,
                 0,
-                &[(LEVEL, kind)],
+                &[(LEVEL_ONE, level_one as i32)],
             )
         };
-        let mut pipelines = vec![pass(1, vec![bindings(1)])?];
-        if levels >= 2 {
-            pipelines.push(pass(2, vec![bindings(2)])?);
-        }
-        if levels >= 3 {
-            pipelines.push(pass(3, (3..=levels).map(bindings).collect())?);
-        }
-        Ok(Self { pipelines })
+        Ok(Self {
+            level_one: pass(true, vec![bindings(1)])?,
+            above: match levels {
+                1 => None,
+                _ => Some(pass(false, (2..=levels).map(bindings).collect())?),
+            },
+        })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -89,11 +85,12 @@ impl GeometryMipsPass {
                 if level > 1 {
                     barrier::compute_to_compute(gpu, cmd);
                 }
-                let (pipeline, set) = match level {
-                    1 | 2 => (level - 1, 0),
-                    _ => (2, level - 3),
-                };
-                self.pipelines[pipeline].dispatch(ctx, set, &[], m.level_extent(level as u32));
+                let extent = m.level_extent(level as u32);
+                match (level, &self.above) {
+                    (1, _) => self.level_one.dispatch(ctx, 0, &[], extent),
+                    (_, Some(above)) => above.dispatch(ctx, level - 2, &[], extent),
+                    (_, None) => unreachable!("levels above 1 have their pipeline"),
+                }
             }
             barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });

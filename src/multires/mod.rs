@@ -18,8 +18,7 @@ pub use crate::settings::{default_levels, MultiresSettings, Upsample, MAX_LEVELS
 
 /// The images of the hierarchy. Geometry mips are mip chains holding levels
 /// 1..=L (mip m is level m + 1, (W >> (m + 1)) x (H >> (m + 1))); level 0 is
-/// the G-buffer itself (`shaders/geo_levels.glsl`). The range chains `geo_min`
-/// and `geo_max`, read only by the geometry mips, start at level 2. The illumination buffer and
+/// the G-buffer itself (`shaders/geo_levels.glsl`). The illumination buffer and
 /// its stencil are 2D arrays with one W x H layer per level, layer l using
 /// its corner.
 pub struct MultiresBuffer {
@@ -112,32 +111,13 @@ impl MultiresBuffer {
                 },
             )
         };
-        // The depth and normal ranges start at level 2 (mip m is level m + 2;
-        // `shaders/geometry_mips.comp` computes levels 1 and 2 from the
-        // G-buffer); with L = 1 one unused mip.
-        let ranges = |name| {
-            Image::new(
-                gpu,
-                &ImageDesc {
-                    name,
-                    format: vk::Format::R32G32B32A32_SFLOAT,
-                    extent: vk::Extent2D {
-                        width: (width >> 2).max(1),
-                        height: (height >> 2).max(1),
-                    },
-                    layers: 1,
-                    mips: levels.saturating_sub(1).max(1),
-                    usage: storage,
-                },
-            )
-        };
         let rgba = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Self {
             levels,
             geo_mean: chain("geo_mean", rgba)?,
             geo_normal: chain("geo_normal", rgba)?,
-            geo_min: ranges("geo_min")?,
-            geo_max: ranges("geo_max")?,
+            geo_min: chain("geo_min", rgba)?,
+            geo_max: chain("geo_max", rgba)?,
             geo_flags: chain("geo_flags", vk::Format::R32_UINT)?,
             illumination: layered(
                 "illumination",
