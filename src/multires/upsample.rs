@@ -45,7 +45,7 @@ impl UpsamplePass {
                 setup,
                 "upsample",
                 "upsample.comp",
-                &[bindings.clone()],
+                std::slice::from_ref(&bindings),
                 4,
                 &[
                     (PULL, pull as i32),
