@@ -8,14 +8,16 @@
 //
 // Discontinuities on texel borders: every texel's range covers its footprint
 // plus a one-pixel ring, so an edge lying exactly on a border is seen by the
-// texels on both sides. Level 1 takes its ranges straight from the G-buffer's
-// 4x4 pixels (its 2x2 children and their ring); level 0 needs none (it is
-// always smooth).
+// texels on both sides; level 0 needs none (it is always smooth). Level 1
+// takes its ranges straight from the G-buffer's 4x4 pixels (its 2x2 children
+// and their ring), each level above merges its children's ranges (the union
+// of their footprints and rings is its footprint and ring).
 //
 // 2:1 balance: a texel splits if it is not smooth, or if any texel of level
 // l - 1 in the 4x4 block around its children (its children and the ring of
 // their neighbours) splits. So no leaf is adjacent to a leaf two levels finer.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -34,7 +36,10 @@ layout(set = 1, binding = 9, rgba32f) writeonly uniform image2D dst_min;
 layout(set = 1, binding = 10, rgba32f) writeonly uniform image2D dst_max;
 layout(set = 1, binding = 11, r32ui) writeonly uniform uimage2D dst_flags;
 
-layout(push_constant) uniform Push { int level; };
+// Level 1 (reads the G-buffer) and the levels above (read level l - 1) are
+// separate pipelines: CPU drivers run both sides of a branch under a lane
+// mask, so a branch on the level would cost every texel the reads of both.
+layout(constant_id = 0) const bool LEVEL_ONE = false;
 
 // Level 0 as the other passes read it (levels above come from src_* here).
 #define GEO_LEVEL0_ONLY
@@ -48,21 +53,32 @@ bool smooth_ranges(vec4 lo, vec4 hi) {
     return depth_ok && normal_ok;
 }
 
-// Depth and normal ranges of a level-1 texel: the G-buffer's pixels with
-// geometry among its 2x2 children and their one-pixel ring.
-void level_one_ranges(ivec2 p, out vec4 lo, out vec4 hi) {
-    lo = vec4(BIG);
-    hi = vec4(-BIG);
+// Level 1 from the G-buffer's 4x4 pixels around texel p (its 2x2 children
+// and their one-pixel ring): the children's sums and the ranges over the
+// pixels with geometry. Each pixel is fetched once and unconditionally
+// (clamped, then masked): fetches under a condition cost CPU drivers as much
+// as taken ones, and the children's fetches are the block's inner 2x2.
+void level_one(ivec2 p, inout vec4 mean, inout vec3 normal, inout float coverage, inout vec4 lo, inout vec4 hi) {
     ivec2 size = ivec2(run.size.xy);
-    for (int dy = -1; dy <= 2; ++dy) {
-        for (int dx = -1; dx <= 2; ++dx) {
+    [[unroll]] for (int dy = -1; dy <= 2; ++dy) {
+        [[unroll]] for (int dx = -1; dx <= 2; ++dx) {
             ivec2 q = 2 * p + ivec2(dx, dy);
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 qp = texelFetch(gbuffer_position, q, 0);
-            if (qp.w <= 0.0) continue;
-            vec4 v = vec4(qp.w, texelFetch(gbuffer_normal, q, 0).xyz);
-            lo = min(lo, v);
-            hi = max(hi, v);
+            bool inside = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size));
+            ivec2 qc = clamp(q, ivec2(0), size - 1);
+            vec4 qp = texelFetch(gbuffer_position, qc, 0);
+            vec3 qn = texelFetch(gbuffer_normal, qc, 0).xyz;
+            if (inside && qp.w > 0.0) {
+                lo = min(lo, vec4(qp.w, qn));
+                hi = max(hi, vec4(qp.w, qn));
+            }
+            // The children (always inside: qc = q), in the order of the
+            // levels above; the compiler merges these fetches with the above.
+            if (dx >= 0 && dx <= 1 && dy >= 0 && dy <= 1) {
+                vec4 cn = level0_normal(qc);
+                mean += cn.w * level0_mean(qc);
+                normal += cn.w * cn.xyz;
+                coverage += cn.w;
+            }
         }
     }
 }
@@ -72,18 +88,19 @@ void coarser_level(ivec2 p) {
     vec3 normal = vec3(0.0);
     float coverage = 0.0;
     vec4 lo = vec4(BIG), hi = vec4(-BIG);
-    for (int i = 0; i < 4; ++i) {
-        ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
-        vec4 cn = level == 1 ? level0_normal(c) : imageLoad(src_normal, c);
-        mean += cn.w * (level == 1 ? level0_mean(c) : imageLoad(src_mean, c));
-        normal += cn.w * cn.xyz;
-        coverage += cn.w;
-        if (level >= 2) {
+    if (LEVEL_ONE) {
+        level_one(p, mean, normal, coverage, lo, hi);
+    } else {
+        for (int i = 0; i < 4; ++i) {
+            ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
+            vec4 cn = imageLoad(src_normal, c);
+            mean += cn.w * imageLoad(src_mean, c);
+            normal += cn.w * cn.xyz;
+            coverage += cn.w;
             lo = min(lo, imageLoad(src_min, c));
             hi = max(hi, imageLoad(src_max, c));
         }
     }
-    if (level == 1) level_one_ranges(p, lo, hi);
     uint flags = 0u;
     if (coverage > 0.0) {
         mean /= coverage;
@@ -95,7 +112,7 @@ void coarser_level(ivec2 p) {
         bool split = (flags & GEO_SMOOTH) == 0u;
         ivec2 below = imageSize(src_flags);
         // Level 0 never splits: level 1 has no finer splits to look at.
-        for (int dy = -1; dy <= 2 && !split && level >= 2; ++dy) {
+        for (int dy = -1; dy <= 2 && !split && !LEVEL_ONE; ++dy) {
             for (int dx = -1; dx <= 2; ++dx) {
                 ivec2 q = 2 * p + ivec2(dx, dy);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, below))) continue;

@@ -25,10 +25,15 @@ layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
 layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
 #include "geo_levels.glsl"
 
-layout(push_constant) uniform Push {
-    int level;
-    int pull_phase;  // 1: pull into `level` from level - 1; 0: push into `level` from level + 1
-};
+// One pipeline per kind of dispatch, specialised: CPU drivers run both sides
+// of a branch under a lane mask, so a branch on a push constant would cost
+// every invocation the code of every kind. INTERPOLATE mirrors the run's
+// HIERARCHY_INTERPOLATE flag (both come from the settings the pass is built with).
+layout(constant_id = 0) const bool PULL = false;        // pull into `level` from level - 1; else push from level + 1
+layout(constant_id = 1) const bool LEVEL_ZERO = false;  // push into level 0 (writes `indirect`)
+layout(constant_id = 2) const bool INTERPOLATE = true;
+
+layout(push_constant) uniform Push { int level; };
 
 const float PULLED = 0.5;
 const float PUSHED = 0.75;
@@ -110,9 +115,9 @@ vec3 interpolate(ivec2 p, vec4 mean, vec3 n, vec3 fallback) {
 
 void push_texel(ivec2 p) {
     vec4 v = imageLoad(illumination, ivec3(p, level));
-    // This texel's geometry, once (level is uniform: one branch per dispatch).
+    // This texel's geometry, once.
     vec4 mean, normal;
-    if (level == 0) {
+    if (LEVEL_ZERO) {
         mean = level0_mean(p);
         normal = level0_normal(p);
     } else {
@@ -123,19 +128,18 @@ void push_texel(ivec2 p) {
     if (v.a <= 0.0 && geometry) {
         ivec2 parent = p >> 1;
         vec3 nearest = inside(parent, level + 1) ? imageLoad(illumination, ivec3(parent, level + 1)).rgb : vec3(0.0);
-        bool interpolated = (run.hierarchy.w & HIERARCHY_INTERPOLATE) != 0;
-        v = vec4(interpolated ? interpolate(p, mean, normal.xyz, nearest) : nearest, PUSHED);
+        v = vec4(INTERPOLATE ? interpolate(p, mean, normal.xyz, nearest) : nearest, PUSHED);
         // Level 0's pushed values go only to `indirect`: nothing reads them
         // from the buffer, and a store per pixel is costly on CPU drivers.
-        if (level > 0) imageStore(illumination, ivec3(p, level), v);
+        if (!LEVEL_ZERO) imageStore(illumination, ivec3(p, level), v);
     }
-    if (level == 0) imageStore(indirect, p, vec4(geometry ? v.rgb : vec3(0.0), 1.0));
+    if (LEVEL_ZERO) imageStore(indirect, p, vec4(geometry ? v.rgb : vec3(0.0), 1.0));
 }
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (!inside(p, level)) return;
-    if (pull_phase != 0) {
+    if (PULL) {
         pull_texel(p);
     } else {
         push_texel(p);

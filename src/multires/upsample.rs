@@ -4,15 +4,27 @@
 //! (nearest or interpolated, by a flag in the frame uniforms).
 //! Reads the illumination buffer and geometry mips; writes `indirect`.
 
-use super::MultiresBuffer;
+use super::{MultiresBuffer, Upsample};
 use crate::frame::{FrameContext, Setup};
-use crate::passes::{push_bytes, ComputePass, INDIRECT_COMPUTE};
+use crate::passes::{ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
-pub struct UpsamplePass(ComputePass);
+/// One pipeline per kind of dispatch (`upsample.comp`'s specialisation
+/// constants): CPU drivers execute every branch of a shader under a lane mask,
+/// so one shader for all three would run all three's code per invocation.
+pub struct UpsamplePass {
+    pull: ComputePass,
+    push: ComputePass,
+    push_level_zero: ComputePass,
+}
+
+/// Specialisation constant ids of `upsample.comp`.
+const PULL: u32 = 0;
+const LEVEL_ZERO: u32 = 1;
+const INTERPOLATE: u32 = 2;
 
 impl UpsamplePass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
@@ -25,14 +37,28 @@ impl UpsamplePass {
             Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
             Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
         ];
-        Ok(Self(ComputePass::new(
-            setup,
-            "upsample",
-            "upsample.comp",
-            &[bindings],
-            8,
-            &[],
-        )?))
+        // The run's uniforms carry the same flag (HIERARCHY_INTERPOLATE); both
+        // come from these settings, and a change of settings rebuilds the passes.
+        let interpolate = (setup.settings.multires.upsample == Upsample::Interpolated) as i32;
+        let pass = |pull: bool, level_zero: bool| {
+            ComputePass::new(
+                setup,
+                "upsample",
+                "upsample.comp",
+                std::slice::from_ref(&bindings),
+                4,
+                &[
+                    (PULL, pull as i32),
+                    (LEVEL_ZERO, level_zero as i32),
+                    (INTERPOLATE, interpolate),
+                ],
+            )
+        };
+        Ok(Self {
+            pull: pass(true, false)?,
+            push: pass(false, false)?,
+            push_level_zero: pass(false, true)?,
+        })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -56,8 +82,13 @@ impl UpsamplePass {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 first = false;
-                let push = push_bytes(&[level as i32, pull as i32]);
-                self.0.dispatch(ctx, 0, &push, m.level_extent(level));
+                let pass = match (pull, level) {
+                    (true, _) => &self.pull,
+                    (false, 0) => &self.push_level_zero,
+                    (false, _) => &self.push,
+                };
+                let push = (level as i32).to_ne_bytes();
+                pass.dispatch(ctx, 0, &push, m.level_extent(level));
             };
             for level in 1..=m.levels {
                 run(level, true);
