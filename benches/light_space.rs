@@ -94,7 +94,7 @@ fn main() -> anyhow::Result<()> {
     }
     // Below 4096 VPLs' error HISR needs patches finer than theirs (depth 6 is
     // their level): depth 7.
-    let deep_taus = [0.02, 0.01, 0.005];
+    let deep_taus = [0.1, 0.05, 0.02, 0.01];
     for tau in deep_taus {
         let lt = LightTreeSettings {
             tau,

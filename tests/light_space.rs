@@ -418,3 +418,23 @@ fn hisr_with_tiles_is_deterministic() {
     assert!(s.light_tree.hisr_tile_level > 0);
     assert_eq!(a.readback.indirect, b.readback.indirect);
 }
+
+#[test]
+fn a_tile_level_out_of_range_is_a_clean_error() {
+    let args = [
+        "render",
+        "--method",
+        "hisr",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--rsm",
+        "32",
+        "--hisr-tile-level",
+        "9",
+    ];
+    let out = bin().args(args).output().unwrap();
+    let err = clean_failure(&out, &args);
+    assert!(err.contains("--hisr-tile-level 9"), "{err}");
+}
