@@ -36,7 +36,7 @@ layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
 // ChosenPatches' buffer here).
 layout(set = 1, binding = 6, std430) readonly buffer HisrCut {
     HisrCutHeader cut_header;
-    uint cut[];  // counts[tiles], then capacity entries per tile
+    uint cut[];  // per level counts, then per level entries (shared.glsl)
 };
 #define GEO_FLAGS
 #include "geo_levels.glsl"
@@ -127,37 +127,45 @@ void traverse(vec3 xi, vec3 ni) {
     for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start));
 }
 
-// The cut of tile t (hisr_cut.comp): its "evaluate" entries are the same for
-// every receiver of the tile, and are summed first in a plain list loop; only
-// the "traverse" entries are walked per fragment.
-void walk_cut(vec3 xi, vec3 ni, uint t) {
-    uint counts = t == HISR_CUT_OVERFLOW ? t : cut[t];
+// From the cuts of the tiles holding texel p of this level (hisr_cut.comp):
+// the finest cut level c0 whose tiles are at least this level's texels, and
+// every coarser one. Their "evaluate" entries together with c0's "traverse"
+// entries are c0's tile's whole cut: the evaluate entries are the same for
+// every receiver of a tile and are summed in plain list loops; only the
+// traverse entries are walked per fragment (in a loop of their own: lavapipe
+// runs both sides of a branch under a lane mask, so one loop with a branch
+// per entry cost the plain entries as much as the walks). Levels coarser
+// than every tile, and tiles whose cut overflowed, traverse from the roots.
+uint tile_at(ivec2 p, int c) {
+    uvec4 lv = cut_header.tiles[c];
+    uvec2 tile = uvec2(p >> (int(lv.z) - level));
+    return tile.y * lv.x + tile.x;
+}
+
+void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
+    int c0 = max(level - int(cut_header.tiles[0].z), 0);
+    if (c0 >= HISR_CUT_LEVELS) {
+        traverse(xi, ni);
+        return;
+    }
+    uint t0 = tile_at(p, c0);
+    uint counts = cut[cut_header.tiles[c0].w + t0];
     if (counts == HISR_CUT_OVERFLOW) {
         traverse(xi, ni);
         return;
     }
-    uint base = cut_header.tiles.x * cut_header.tiles.y + t * cut_header.tiles.w;
-    uint evaluate = counts & 0xffffu;
-    for (uint i = 0u; i < evaluate; ++i) {
-        LightPatch lp = patches[node_index(cut_node(cut[base + i]))];
-        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+    for (int c = HISR_CUT_LEVELS - 1; c >= c0; --c) {
+        uint t = tile_at(p, c);
+        uint n = (c == c0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
+        uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
+        for (uint i = 0u; i < n; ++i) {
+            LightPatch lp = patches[node_index(cut_node(cut[base + i]))];
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+        }
     }
-    uint last = base + cut_header.tiles.w - 1u;
+    uint capacity = cut_header.capacity[c0];
+    uint last = cut_header.entries[1 + c0] + t0 * capacity + capacity - 1u;
     for (uint i = 0u; i < counts >> 16; ++i) traverse_from(xi, ni, cut_node(cut[last - i]));
-}
-
-// From the cut of the tile holding texel p of this level. Levels coarser than
-// the tile traverse from the roots. (Making the tile subgroup-uniform where
-// the lanes share it, so that each entry is one load for all lanes, was no
-// faster on lavapipe: docs/algorithm.md section 4.4.)
-void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
-    int k = int(cut_header.tiles.z);
-    uint t = HISR_CUT_OVERFLOW;
-    if (level <= k) {
-        ivec2 tile = p >> (k - level);
-        t = uint(tile.y) * cut_header.tiles.x + uint(tile.x);
-    }
-    walk_cut(xi, ni, t);
 }
 
 void main() {

@@ -17,9 +17,12 @@
 // The box is padded by a little more than float rounding so that a receiver
 // on its surface is decided alike too.
 //
-// One invocation per tile, depth-first without a stack, entries written in
+// One dispatch per chained level (HISR_CUT_LEVELS, coarsest first), one
+// invocation per tile, depth-first without a stack, entries written in
 // traversal order (so the gather's sums come in the same order every
-// frame). A tile whose list does not fit is marked HISR_CUT_OVERFLOW and its
+// frame). A finer tile lies inside its parent, so its box does too, and its
+// cut only refines the parent's traverse entries. A tile whose list does not
+// fit, or whose parent's did not, is marked HISR_CUT_OVERFLOW and its
 // fragments traverse from the roots (same result, slower).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
@@ -33,17 +36,20 @@ layout(set = 1, binding = 1, std430) readonly buffer LightTree {
     uint pad0, pad1, pad2;
     LightPatch nodes[];  // the packed tree (light_tree_pack.comp)
 };
-layout(set = 1, binding = 2, std430) writeonly buffer HisrCut {
+layout(set = 1, binding = 2, std430) buffer HisrCut {
     HisrCutHeader header;
-    uint cut[];  // counts[tiles], then capacity entries per tile
+    uint cut[];  // per level counts, then per level entries (shared.glsl)
 };
 
-layout(push_constant) uniform Push { uvec4 tiles; };  // as HisrCutHeader.tiles
+layout(push_constant) uniform Push {
+    HisrCutHeader layout_;  // what the header will hold
+    int level;              // the cut level c this dispatch makes
+};
 
 // The box of tile `tile`'s positions, padded (see above); lo.x > hi.x if it
 // has none.
 void tile_box(ivec2 tile, out vec3 lo, out vec3 hi) {
-    int side = 1 << tiles.z;
+    int side = 1 << layout_.tiles[level].z;
     ivec2 origin = tile * side;
     ivec2 end = min(origin + side, ivec2(run.size.xy));
     lo = vec3(3.0e38);
@@ -63,25 +69,45 @@ void tile_box(ivec2 tile, out vec3 lo, out vec3 hi) {
 }
 
 void main() {
+    uvec4 lv = layout_.tiles[level];
+    uint capacity = layout_.capacity[level];
     ivec2 tile = ivec2(gl_GlobalInvocationID.xy);
-    if (tile == ivec2(0)) header.tiles = tiles;
-    if (any(greaterThanEqual(tile, ivec2(tiles.xy)))) return;
-    uint t = uint(tile.y) * tiles.x + uint(tile.x);
-    uint base = tiles.x * tiles.y + t * tiles.w;
+    if (level == 0 && tile == ivec2(0)) header = layout_;
+    if (any(greaterThanEqual(tile, ivec2(lv.xy)))) return;
+    uint t = uint(tile.y) * lv.x + uint(tile.x);
+    uint base = layout_.entries[1 + level] + t * capacity;
+    // Roots: the start depth's nodes for the coarsest level, else the parent
+    // tile's traverse entries (its evaluate entries hold for this tile too).
+    int start = run.light_levels.x;
+    int side = 1 << start;
+    uint roots = uint(side * side);
+    uint parent_last = 0u;
+    if (level + 1 < HISR_CUT_LEVELS) {
+        uvec4 lp = layout_.tiles[level + 1];
+        uvec2 pt = uvec2(tile >> 1);
+        uint p = pt.y * lp.x + pt.x;
+        uint counts = cut[lp.w + p];
+        if (counts == HISR_CUT_OVERFLOW) {
+            cut[lv.w + t] = HISR_CUT_OVERFLOW;
+            return;
+        }
+        roots = counts >> 16;
+        uint parent_capacity = layout_.capacity[level + 1];
+        parent_last = layout_.entries[2 + level] + p * parent_capacity + parent_capacity - 1u;
+    }
     vec3 lo, hi;
     tile_box(tile, lo, hi);
     if (lo.x > hi.x) {  // no geometry: no receivers
-        cut[t] = 0u;
+        cut[lv.w + t] = 0u;
         return;
     }
-    int start = run.light_levels.x;
     int max_depth = run.light_levels.y;
-    int side = 1 << start;
     uint evaluate = 0u, traverse = 0u;
-    // Depth-first from each start node, without a stack (as gather.frag's
+    // Depth-first from each root, without a stack (as gather.frag's
     // traverse_from), so the entries come in the same order every frame.
-    for (int r = 0; r < side * side; ++r) {
-        ivec3 root = ivec3(r % side, r / side, start);
+    for (uint r = 0u; r < roots; ++r) {
+        ivec3 root = level + 1 < HISR_CUT_LEVELS ? cut_node(cut[parent_last - r])
+                                                 : ivec3(int(r) % side, int(r) / side, start);
         ivec3 node = root;
         for (;;) {
             LightPatch lp = nodes[node_index(node)];
@@ -98,8 +124,8 @@ void main() {
                 bool disagree = deeper && dot(near, near) <= reach;
                 // Evaluate entries from the front of the range, traverse
                 // entries from the back; they must not meet.
-                if (evaluate + traverse < tiles.w) {
-                    uint at = disagree ? base + tiles.w - 1u - traverse : base + evaluate;
+                if (evaluate + traverse < capacity) {
+                    uint at = disagree ? base + capacity - 1u - traverse : base + evaluate;
                     cut[at] = cut_entry(node);
                 }
                 if (disagree) {
@@ -114,5 +140,5 @@ void main() {
             node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
         }
     }
-    cut[t] = evaluate + traverse > tiles.w ? HISR_CUT_OVERFLOW : evaluate | (traverse << 16);
+    cut[lv.w + t] = evaluate + traverse > capacity ? HISR_CUT_OVERFLOW : evaluate | (traverse << 16);
 }

@@ -77,15 +77,22 @@ const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR 
 // (gather.frag, docs/algorithm.md section 4.3).
 const float HISR_INVALID_TAU_SCALE = 0.01;
 
-// Header of HISR's per-tile cut buffer (hisr_cut.comp writes it, gather.frag
-// reads it; docs/algorithm.md section 4.4). After it: uint counts[tiles.x *
-// tiles.y], then capacity entries per tile (cut_entry in hisr.glsl): a tile's
-// "evaluate" entries from the front of its range, its "traverse" entries from
-// the back. A count holds the evaluate entries in bits 0-15 and the traverse
-// entries in bits 16-31, or is HISR_CUT_OVERFLOW.
+// HISR's per-tile cuts (docs/algorithm.md section 4.4) come in
+// HISR_CUT_LEVELS chained levels: level c has tiles of 2^(K + c) pixels a
+// side; the coarsest is cut from the start depth, each finer one from its
+// parent tile's "traverse" entries. Layout of the buffer (hisr_cut.comp
+// writes it, gather.frag reads it): this header, then per level a count per
+// tile, then per level `capacity` entries per tile (cut_entry in hisr.glsl):
+// a tile's "evaluate" entries from the front of its range, its "traverse"
+// entries from the back. A count holds the evaluate entries in bits 0-15 and
+// the traverse entries in bits 16-31, or is HISR_CUT_OVERFLOW. Offsets count
+// uints after the header.
+const int HISR_CUT_LEVELS = 3;
 struct HisrCutHeader {
-    uvec4 tiles;  // x, y: tiles per row and per column; z: tile level K (a tile covers
-                  // 2^K x 2^K pixels); w: capacity, entries per tile
+    uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
+                                   // level K + c; w: offset of its counts
+    uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: unused
+    uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
 };
 
 // A tile whose cut did not fit: its fragments traverse from the roots.

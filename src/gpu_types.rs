@@ -93,14 +93,20 @@ pub struct LightPatch {
 /// Header of the chosen-patch buffer before the `LightPatch` array.
 pub const CHOSEN_PATCHES_HEADER: usize = 16;
 
+/// Chained levels of HISR's tile cuts, as in `shaders/shared.glsl`.
+pub const HISR_CUT_LEVELS: usize = 3;
+
 /// `HisrCutHeader` (std430): the head of HISR's per-tile cut buffer
-/// (`shaders/hisr_cut.comp`), followed by a count per tile and `tiles[3]`
-/// entries per tile.
+/// (`shaders/hisr_cut.comp`): per level, tiles per row and column, tile level
+/// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
+/// and its entries per tile (`capacity[c]`); offsets in `u32`s after the
+/// header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct HisrCutHeader {
-    /// Tiles per row and per column, tile level K, entries per tile.
-    pub tiles: [u32; 4],
+    pub tiles: [[u32; 4]; HISR_CUT_LEVELS],
+    pub entries: [u32; 4],
+    pub capacity: [u32; 4],
 }
 
 /// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.

@@ -144,7 +144,11 @@ fn light_patch_matches_shared_glsl() {
 #[test]
 fn hisr_cut_header_matches_shared_glsl() {
     for shader in ["hisr_cut.comp", "gather.frag"] {
-        check!(shader, HisrCutHeader, "HisrCutHeader", tiles: 16, [tiles => "tiles"]);
+        check!(shader, HisrCutHeader, "HisrCutHeader", capacity: 16, [
+            tiles => "tiles",
+            entries => "entries",
+            capacity => "capacity",
+        ]);
     }
 }
 
@@ -219,6 +223,7 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("PRESENT_VIEW_HOST"), PRESENT_VIEW_HOST as u32);
     assert_eq!(value("LIGHT_SPOT"), LIGHT_SPOT as u32);
     assert_eq!(value("HISR_CUT_OVERFLOW"), HISR_CUT_OVERFLOW);
+    assert_eq!(value("HISR_CUT_LEVELS"), HISR_CUT_LEVELS as u32);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
     assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {

@@ -360,9 +360,10 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
                 hisr_tile_level: k,
                 ..Default::default()
             },
-            // Levels 0-3: with K = 1, levels 2 and 3 are coarser than a tile.
+            // Levels 0-4: with K = 1 the cut levels' tiles are 2, 4 and 8
+            // pixels a side, and level 4's patches are coarser than all.
             multires: MultiresSettings {
-                levels: Some(3),
+                levels: Some(4),
                 ..Default::default()
             },
             ..Default::default()
@@ -371,7 +372,10 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
         if tau < 1e-3 {
             // Every node splits to max depth 6 for every receiver: 4096
             // leaves in each tile's cut, more than it holds.
-            assert!(isr::methods::hisr::cut_layout(&tiled)[3] < 4096, "{label}");
+            assert!(
+                isr::methods::hisr::cut_layout(&tiled).capacity[2] < 4096,
+                "{label}"
+            );
         }
         let roots = render_multires(&gpu, &scene, &with(0));
         let cut = render_multires(&gpu, &scene, &tiled);

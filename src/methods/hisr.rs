@@ -10,7 +10,7 @@ use super::gather::{
     GatherPass, LightPatches, LightSpacePass, MultiresMethod, PatchList, PatchListPass,
 };
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::HisrCutHeader;
+use crate::gpu_types::{HisrCutHeader, HISR_CUT_LEVELS};
 use crate::passes::{ComputePass, INDIRECT_COMPUTE};
 use crate::settings::RenderSettings;
 use crate::vk::barrier;
@@ -82,20 +82,42 @@ impl LightSpacePass for HisrLightPass {
     }
 }
 
-/// The most entries a tile's cut holds; fewer when there are many tiles, so
-/// that the buffer stays under `CUT_BUFFER_BUDGET`. A tile whose cut does not
-/// fit traverses from the roots (the same image, slower).
-const CUT_CAPACITY: u64 = 2048;
+/// The most entries a tile's cut holds, per chained level (finest first): the
+/// coarsest holds most of each receiver's cut, the finer ones only what they
+/// refine of their parent's traverse entries. All scale down together when
+/// there are so many tiles that the buffer would pass `CUT_BUFFER_BUDGET`. A
+/// tile whose cut does not fit traverses from the roots (the same image,
+/// slower).
+const CUT_CAPACITY: [u64; HISR_CUT_LEVELS] = [1024, 1024, 2048];
 const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 
-/// Tiles per row and column, tile level and entries per tile
-/// (`HisrCutHeader::tiles`) for `s`.
-pub fn cut_layout(s: &RenderSettings) -> [u32; 4] {
+/// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
+/// has tiles of 2^(K + c) pixels a side; each level's counts, then each
+/// level's entries, `capacity` per tile.
+pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = s.light_tree.hisr_tile_level;
-    let (tx, ty) = (s.width.div_ceil(1 << k), s.height.div_ceil(1 << k));
-    let tiles = tx as u64 * ty as u64;
-    let capacity = (CUT_BUFFER_BUDGET / 4 / tiles).clamp(64, CUT_CAPACITY);
-    [tx, ty, k, capacity as u32]
+    let mut header = HisrCutHeader::default();
+    let mut tiles = [0u64; HISR_CUT_LEVELS];
+    let mut offset = 0u64;
+    for (c, level) in header.tiles.iter_mut().enumerate() {
+        let side = 1u32 << (k + c as u32);
+        let (tx, ty) = (s.width.div_ceil(side), s.height.div_ceil(side));
+        tiles[c] = tx as u64 * ty as u64;
+        *level = [tx, ty, k + c as u32, offset as u32];
+        offset += tiles[c];
+    }
+    let full: u64 = (0..HISR_CUT_LEVELS)
+        .map(|c| tiles[c] * CUT_CAPACITY[c])
+        .sum();
+    // Entries over the budget: scale every level's capacity down alike.
+    let scale = (CUT_BUFFER_BUDGET as f64 / 4.0 / full as f64).min(1.0);
+    for c in 0..HISR_CUT_LEVELS {
+        let capacity = ((CUT_CAPACITY[c] as f64 * scale) as u64).max(64);
+        header.capacity[c] = capacity as u32;
+        header.entries[1 + c] = offset as u32;
+        offset += tiles[c] * capacity;
+    }
+    header
 }
 
 /// Bytes of the cut buffer (0 without tiles).
@@ -103,23 +125,29 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
     if s.light_tree.hisr_tile_level == 0 {
         return 0;
     }
-    let [tx, ty, _, capacity] = cut_layout(s);
-    let tiles = tx as u64 * ty as u64;
-    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * tiles * (1 + capacity as u64)
+    let header = cut_layout(s);
+    let entries: u64 = (0..HISR_CUT_LEVELS)
+        .map(|c| {
+            let t = header.tiles[c];
+            t[0] as u64 * t[1] as u64 * (1 + header.capacity[c] as u64)
+        })
+        .sum();
+    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * entries
 }
 
 /// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
-/// one invocation per eye-space tile. Reads the G-buffer positions and the
-/// packed tree; writes the cut buffer (barriers in `record`).
+/// one dispatch per chained level, coarsest first, one invocation per
+/// eye-space tile. Reads the G-buffer positions, the packed tree and the
+/// coarser level's cuts; writes the cut buffer (barriers in `record`).
 struct CutPass {
     pass: ComputePass,
     buffer: Buffer,
-    tiles: [u32; 4],
+    header: HisrCutHeader,
 }
 
 impl CutPass {
     fn new(setup: &Setup, tree: &Buffer) -> Result<Self> {
-        let tiles = cut_layout(setup.settings);
+        let header = cut_layout(setup.settings);
         let buffer = Buffer::new(
             setup.gpu,
             "hisr-cut",
@@ -133,11 +161,19 @@ impl CutPass {
             Binding::storage("LightTree", tree),
             Binding::storage("HisrCut", &buffer),
         ];
-        let pass = ComputePass::new(setup, "hisr-cut", "hisr_cut.comp", &[bindings], 16, &[])?;
+        let push_bytes = std::mem::size_of::<HisrCutHeader>() as u32 + 4;
+        let pass = ComputePass::new(
+            setup,
+            "hisr-cut",
+            "hisr_cut.comp",
+            &[bindings],
+            push_bytes,
+            &[],
+        )?;
         Ok(Self {
             pass,
             buffer,
-            tiles,
+            header,
         })
     }
 
@@ -156,14 +192,21 @@ impl CutPass {
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             );
-            let [tx, ty, ..] = self.tiles;
-            let push: Vec<u8> = bytemuck::cast_slice(&self.tiles).to_vec();
-            // One invocation per tile.
-            let extent = vk::Extent2D {
-                width: tx,
-                height: ty,
-            };
-            self.pass.dispatch(ctx, 0, &push, extent);
+            for c in (0..HISR_CUT_LEVELS).rev() {
+                if c + 1 < HISR_CUT_LEVELS {
+                    // Level c reads level c + 1's cuts.
+                    barrier::compute_to_compute(gpu, cmd);
+                }
+                let mut push = bytemuck::bytes_of(&self.header).to_vec();
+                push.extend_from_slice(&(c as i32).to_ne_bytes());
+                // One invocation per tile.
+                let [tx, ty, ..] = self.header.tiles[c];
+                let extent = vk::Extent2D {
+                    width: tx,
+                    height: ty,
+                };
+                self.pass.dispatch(ctx, 0, &push, extent);
+            }
             barrier::memory(
                 gpu,
                 cmd,
