@@ -5,7 +5,9 @@
 //! eye-space patches, so the error is the light-space choice alone. Then the
 //! issue-12 goals as ratios from the same run: HISR's time at Basic ISR's
 //! error and at 4096 VPLs' error, against theirs. `ISR_BENCH_SIZE=256` for a
-//! quicker run. Writes `target/bench/light_space.json`.
+//! quicker run. Times are the least indirect time of 5 frames (after one
+//! warm-up): on a shared CPU the least disturbed frame is the steadiest
+//! measure. Writes `target/bench/light_space.json`.
 
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
@@ -31,7 +33,7 @@ fn run(gpu: &Gpu, label: &str, s: &RenderSettings, frames: u32) -> anyhow::Resul
     eprintln!("{label}: done");
     Ok(Run {
         label: label.into(),
-        indirect_ms: stats.gpu_ms_median(true).unwrap_or(f64::NAN),
+        indirect_ms: stats.gpu_ms_min(true).unwrap_or(f64::NAN),
         patches_per_eye_patch: light.per_patch_mean,
         indirect,
     })
@@ -68,7 +70,7 @@ fn main() -> anyhow::Result<()> {
             &gpu,
             &format!("multires-gather {n}"),
             &with(Method::MultiresGather, n, Default::default()),
-            3,
+            5,
         )?);
     }
     runs.push(run(
@@ -89,7 +91,7 @@ fn main() -> anyhow::Result<()> {
             &gpu,
             &format!("hisr tau {tau}"),
             &with(Method::Hisr, 256, lt),
-            3,
+            5,
         )?);
     }
     // Below 4096 VPLs' error HISR needs patches finer than theirs (depth 6 is
@@ -105,7 +107,7 @@ fn main() -> anyhow::Result<()> {
             &gpu,
             &format!("hisr tau {tau}, depth 7"),
             &with(Method::Hisr, 256, lt),
-            3,
+            5,
         )?);
     }
     let no_tiles = LightTreeSettings {

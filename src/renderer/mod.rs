@@ -56,8 +56,17 @@ impl FrameStats {
     /// Median over frames of the summed time of all passes, or of the passes
     /// that exist only for indirect light; `None` without timestamps.
     pub fn gpu_ms_median(&self, indirect_only: bool) -> Option<f64> {
-        let sums: Vec<f64> = self
-            .frames
+        crate::report::median(&self.gpu_ms_sums(indirect_only))
+    }
+
+    /// The least over frames of the same sums: on a shared or loaded
+    /// machine, the least disturbed frame.
+    pub fn gpu_ms_min(&self, indirect_only: bool) -> Option<f64> {
+        self.gpu_ms_sums(indirect_only).into_iter().reduce(f64::min)
+    }
+
+    fn gpu_ms_sums(&self, indirect_only: bool) -> Vec<f64> {
+        self.frames
             .iter()
             .filter_map(|f| {
                 f.iter()
@@ -65,8 +74,7 @@ impl FrameStats {
                     .map(|p| p.gpu_ms)
                     .try_fold(0.0, |acc, ms| Some(acc + ms?))
             })
-            .collect();
-        crate::report::median(&sums)
+            .collect()
     }
 }
 
