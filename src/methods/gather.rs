@@ -238,16 +238,22 @@ impl LightSpacePass for PatchListPass {
                 );
             }
             self.pass.dispatch(ctx, 0, &[], self.extent);
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                readers,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
-            );
+            written_for_gather(ctx);
         });
     }
+}
+
+/// Barrier after a light-space pass: what it wrote (compute) is read by the
+/// gather (fragment) and by readback (copy).
+pub fn written_for_gather(ctx: &FrameContext) {
+    barrier::memory(
+        ctx.gpu,
+        ctx.cmd,
+        vk::PipelineStageFlags2::COMPUTE_SHADER,
+        vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY,
+        vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
+    );
 }
 
 /// A method that works through the multiresolution buffer: `multires-gather`,

@@ -7,7 +7,8 @@
 //! module makes the method and its passes and holds its constants.
 
 use super::gather::{
-    GatherPass, LightPatches, LightSpacePass, MultiresMethod, PatchList, PatchListPass,
+    written_for_gather, GatherPass, LightPatches, LightSpacePass, MultiresMethod, PatchList,
+    PatchListPass,
 };
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::{HisrCutHeader, HISR_CUT_LEVELS};
@@ -207,14 +208,7 @@ impl CutPass {
                 };
                 self.pass.dispatch(ctx, 0, &push, extent);
             }
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                readers,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
-            );
+            written_for_gather(ctx);
         });
     }
 }
