@@ -100,7 +100,8 @@ const uint HISR_CUT_OVERFLOW = 4294967295u;
 
 // hierarchy.w bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
-const int HIERARCHY_INTERPOLATE = 2;   // interpolated (not nearest) upsampling
+// (Bit 2 is free: nearest or interpolated upsampling is a specialisation
+// constant of upsample.comp.)
 const int HIERARCHY_STENCIL_OFF = 4;   // gather every texel, mask afterwards
 
 // Geometry-mip flag bits (image geo_flags).

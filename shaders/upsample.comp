@@ -27,8 +27,8 @@ layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
 
 // One pipeline per kind of dispatch, specialised: CPU drivers run both sides
 // of a branch under a lane mask, so a branch on a push constant would cost
-// every invocation the code of every kind. INTERPOLATE mirrors the run's
-// HIERARCHY_INTERPOLATE flag (both come from the settings the pass is built with).
+// every invocation the code of every kind. INTERPOLATE comes from the
+// settings the pass is built with (new settings rebuild the passes).
 layout(constant_id = 0) const bool PULL = false;        // pull into `level` from level - 1; else push from level + 1
 layout(constant_id = 1) const bool LEVEL_ZERO = false;  // push into level 0 (writes `indirect`)
 layout(constant_id = 2) const bool INTERPOLATE = true;

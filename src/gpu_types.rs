@@ -119,7 +119,6 @@ pub const PATCH_INVALID: f32 = -1.0;
 
 /// `hierarchy.w` bits, as in `shaders/shared.glsl`.
 pub const HIERARCHY_POINT_VPLS: i32 = 1;
-pub const HIERARCHY_INTERPOLATE: i32 = 2;
 pub const HIERARCHY_STENCIL_OFF: i32 = 4;
 
 /// Geometry-mip flag bits, as in `shaders/shared.glsl`.

@@ -213,7 +213,6 @@ fn flag_constants_match_shared_glsl() {
     };
     use isr::gpu_types::*;
     assert_eq!(value("HIERARCHY_POINT_VPLS"), HIERARCHY_POINT_VPLS as u32);
-    assert_eq!(value("HIERARCHY_INTERPOLATE"), HIERARCHY_INTERPOLATE as u32);
     assert_eq!(value("HIERARCHY_STENCIL_OFF"), HIERARCHY_STENCIL_OFF as u32);
     assert_eq!(value("GEO_HAS_GEOMETRY"), GEO_HAS_GEOMETRY);
     assert_eq!(value("GEO_SMOOTH"), GEO_SMOOTH);

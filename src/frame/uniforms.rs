@@ -4,7 +4,7 @@
 
 use crate::gpu_types::{self, FrameUniforms, InstanceTransform, RunUniforms};
 use crate::scene::{FrameState, LightKind};
-use crate::settings::{RenderSettings, Upsample, VplSampling};
+use crate::settings::{RenderSettings, VplSampling};
 use crate::view::{self, LightView};
 
 /// What the shaders need of `state` for an image of `s.width` x `s.height`,
@@ -54,9 +54,6 @@ pub fn run_uniforms(s: &RenderSettings) -> RunUniforms {
     let mut flags = 0;
     if s.vpl_sampling == VplSampling::Point {
         flags |= gpu_types::HIERARCHY_POINT_VPLS;
-    }
-    if s.multires.upsample == Upsample::Interpolated {
-        flags |= gpu_types::HIERARCHY_INTERPOLATE;
     }
     if !s.multires.stencil {
         flags |= gpu_types::HIERARCHY_STENCIL_OFF;

@@ -1,7 +1,7 @@
 //! Pass `upsample`: the illumination buffer to a full-resolution indirect image
 //! (docs/algorithm.md section 3, step 7), `shaders/upsample.comp`: a pull from
 //! level 1 up to L, then a push from L - 1 down to 0, which writes `indirect`
-//! (nearest or interpolated, by a flag in the frame uniforms).
+//! (nearest or interpolated, by a specialisation constant).
 //! Reads the illumination buffer and geometry mips; writes `indirect`.
 
 use super::{MultiresBuffer, Upsample};
@@ -37,8 +37,7 @@ impl UpsamplePass {
             Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
             Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
         ];
-        // The run's uniforms carry the same flag (HIERARCHY_INTERPOLATE); both
-        // come from these settings, and a change of settings rebuilds the passes.
+        // From these settings; a change of settings rebuilds the passes.
         let interpolate = (setup.settings.multires.upsample == Upsample::Interpolated) as i32;
         let pass = |pull: bool, level_zero: bool| {
             ComputePass::new(
