@@ -88,11 +88,9 @@ void patch_list(vec3 xi, vec3 ni) {
 // costs about 520 evaluations per fragment in the Cornell box whatever tau
 // is; docs/algorithm.md section 4.3 has the measurements behind the scale.
 //
-// Depth-first without a stack: the tree is implicit (a node's children are
-// (2x + i, 2y + j) one depth down), so the next node after one that is not
-// split is its next sibling, or that of the nearest ancestor that has one,
-// found by arithmetic. Children are taken in the order (0,0), (1,0), (0,1),
-// (1,1). No per-fragment array: on GPUs a stack spills to memory, and CPU
+// Depth-first without a stack (next_node in hisr.glsl): the tree is implicit
+// (a node's children are (2x + i, 2y + j) one depth down), so the next node
+// follows from its coordinates. No per-fragment array: on GPUs a stack spills to memory, and CPU
 // drivers turn each indexed access into selects over all its entries.
 // The nodes come from the packed tree (light_tree_pack.comp, bound as
 // ChosenPatches; node_index in hisr.glsl).
@@ -113,10 +111,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
             }
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
         }
-        // Up past the last children (1, 1), then on to the next sibling.
-        while (node.z > root.z && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
-        if (node.z == root.z) return;
-        node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
+        if (!next_node(node, root.z)) return;
     }
 }
 

@@ -20,6 +20,17 @@ float hisr_reach(LightPatch lp, ivec3 node) {
     return reach;
 }
 
+// Depth-first order without a stack: the tree is implicit, so after a node
+// that is not split comes its next sibling (children in the order (0,0),
+// (1,0), (0,1), (1,1)), or that of its nearest ancestor that has one. Moves
+// `node` there; false when the subtree of the root at depth root_depth is done.
+bool next_node(inout ivec3 node, int root_depth) {
+    while (node.z > root_depth && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
+    if (node.z == root_depth) return false;
+    node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
+    return true;
+}
+
 // A cut entry (HisrCutHeader): x in bits 0-11, y in 12-23, depth in 24-27
 // (the tree is at most 12 deep).
 uint cut_entry(ivec3 node) { return uint(node.x) | (uint(node.y) << 12) | (uint(node.z) << 24); }

@@ -134,10 +134,7 @@ void main() {
                     ++evaluate;
                 }
             }
-            // Up past the last children (1, 1), then on to the next sibling.
-            while (node.z > root.z && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
-            if (node.z == root.z) break;
-            node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
+            if (!next_node(node, root.z)) break;
         }
     }
     cut[lv.w + t] = evaluate + traverse > capacity ? HISR_CUT_OVERFLOW : evaluate | (traverse << 16);
