@@ -85,9 +85,10 @@ pub struct LightTreeSettings {
     pub max_depth: Option<u32>,
     /// HISR's error threshold tau, as a fraction of the light's peak intensity.
     pub tau: f32,
-    /// HISR's eye-space tiles cover 2^K x 2^K pixels: the traversal shared by
-    /// a tile's receivers is found once per tile (`hisr-cut`, docs/algorithm.md
-    /// section 4.4). 0: every fragment traverses from the roots.
+    /// HISR's eye-space tiles cover 2^K, 2^(K+1) and 2^(K+2) pixels a side
+    /// (three chained levels): the traversal shared by a tile's receivers is
+    /// found once per tile (`hisr-cut`, docs/algorithm.md section 4.4). 0:
+    /// every fragment traverses from the roots.
     pub hisr_tile_level: u32,
 }
 

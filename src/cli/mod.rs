@@ -137,8 +137,9 @@ struct RenderArgs {
     /// light patch is subdivided while its contribution could exceed tau * I.
     #[arg(long, default_value_t = D.light_tree.tau)]
     tau: f32,
-    /// HISR finds the traversal shared by each 2^K x 2^K-pixel tile once per
-    /// tile (pass hisr-cut); 0 traverses from the roots in every fragment.
+    /// HISR finds the traversal shared by each tile of 2^K, 2^(K+1) and
+    /// 2^(K+2) pixels a side once per tile (pass hisr-cut); 0 traverses from
+    /// the roots in every fragment.
     /// Same image either way (up to float rounding).
     #[arg(long, default_value_t = D.light_tree.hisr_tile_level)]
     hisr_tile_level: u32,

@@ -18,7 +18,7 @@ use crate::vk::barrier;
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -51,7 +51,7 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
     };
     let light = HisrLightPass { pack, cut };
     MultiresMethod::new(setup, Some(Box::new(light)), move |setup, m, light| {
-        let light = light.expect("hisr has a light-space pass");
+        let light = light.ok_or_else(|| anyhow!("hisr gathers from its packed tree"))?;
         Ok(Box::new(GatherPass::new(setup, m, source, light)?))
     })
 }
