@@ -77,9 +77,9 @@ fn main() -> anyhow::Result<()> {
         &gpu,
         "isr (base 64)",
         &with(Method::Isr, 256, Default::default()),
-        3,
+        5,
     )?);
-    // The HISR curve (tiles of 16x16 pixels, the default); one point
+    // The HISR curve (default tiles); one point
     // without tiles (every fragment traverses from the roots) for comparison.
     let hisr_taus = [0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005];
     for tau in hisr_taus {
@@ -118,7 +118,7 @@ fn main() -> anyhow::Result<()> {
         &gpu,
         "hisr tau 0.05, no tiles",
         &with(Method::Hisr, 256, no_tiles),
-        3,
+        5,
     )?);
     let mut rows = Vec::new();
     println!(
