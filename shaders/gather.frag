@@ -95,17 +95,12 @@ void patch_list(vec3 xi, vec3 ni) {
 // The nodes come from the packed tree (light_tree_pack.comp, bound as
 // ChosenPatches; node_index in hisr.glsl).
 void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
-    int max_depth = run.light_levels.y;
     ivec3 node = root;  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     for (;;) {
         LightPatch lp = patches[node_index(node)];
-        if (lp.position_area.w > 0.0) {  // else: saw nothing
-            bool split = false;
-            if (node.z < max_depth) {
-                vec3 vij = lp.position_area.xyz - xi;
-                split = dot(vij, vij) <= hisr_reach(lp, node);
-            }
-            if (split) {
+        if (lp.position_area.w > 0.0) {
+            vec3 vij = lp.position_area.xyz - xi;
+            if (dot(vij, vij) <= lp.flux.a) {
                 node = ivec3(2 * node.xy, node.z + 1);
                 continue;
             }
@@ -154,7 +149,7 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
         uint n = (c == c0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
         uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
         for (uint i = 0u; i < n; ++i) {
-            LightPatch lp = patches[node_index(cut_node(cut[base + i]))];
+            LightPatch lp = patches[cut[base + i]];  // a packed index
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
         }
     }

@@ -9,11 +9,15 @@
 // (light_tree_pack.comp): depth-major from the root, row-major inside.
 int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
 
-// The node's squared reach: patch j splits for receiver i iff it is above the
-// max depth and |V_ij|^2 <= hisr_reach (gather.frag has the derivation; the
-// per-level factor 4^k, k levels above the finest RSM texel). Invalid patches
-// are held to tau * HISR_INVALID_TAU_SCALE.
+// The node's squared reach: patch j splits for receiver i iff
+// |V_ij|^2 <= reach (gather.frag has the derivation; the per-level factor
+// 4^k, k its levels above the finest RSM texel). Invalid patches are held to
+// tau * HISR_INVALID_TAU_SCALE. Nodes at the max depth, and empty ones, never
+// split: -1. light-tree-pack stores it in the packed node's flux.a, so the
+// traversal and the tile cut test a node with one comparison and decide
+// exactly alike.
 float hisr_reach(LightPatch lp, ivec3 node) {
+    if (node.z >= run.light_levels.y || lp.position_area.w <= 0.0) return -1.0;
     int mip = run.light_levels.w - node.z;
     float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.light_tree.x);
     if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
@@ -24,15 +28,19 @@ float hisr_reach(LightPatch lp, ivec3 node) {
 // that is not split comes its next sibling (children in the order (0,0),
 // (1,0), (0,1), (1,1)), or that of its nearest ancestor that has one. Moves
 // `node` there; false when the subtree of the root at depth root_depth is done.
+// The ancestors to climb are the last children in a row: as many levels as
+// x & y has trailing ones (no loop, so no divergent inner loop per lane).
 bool next_node(inout ivec3 node, int root_depth) {
-    while (node.z > root_depth && (node.x & node.y & 1) == 1) node = ivec3(node.xy >> 1, node.z - 1);
+    int up = min(findLSB(~(node.x & node.y)), node.z - root_depth);
+    node = ivec3(node.xy >> up, node.z - up);
     if (node.z == root_depth) return false;
     node.xy += (node.x & 1) == 0 ? ivec2(1, 0) : ivec2(-1, 1);
     return true;
 }
 
-// A cut entry (HisrCutHeader): x in bits 0-11, y in 12-23, depth in 24-27
-// (the tree is at most 12 deep).
+// A traverse entry of a tile's cut (HisrCutHeader): x in bits 0-11, y in
+// 12-23, depth in 24-27 (the tree is at most 12 deep). Evaluate entries are
+// the node's packed index (node_index), read without decoding.
 uint cut_entry(ivec3 node) { return uint(node.x) | (uint(node.y) << 12) | (uint(node.z) << 24); }
 
 ivec3 cut_node(uint entry) { return ivec3(entry & 0xfffu, (entry >> 12) & 0xfffu, (entry >> 24) & 0xfu); }

@@ -101,7 +101,6 @@ void main() {
         cut[lv.w + t] = 0u;
         return;
     }
-    int max_depth = run.light_levels.y;
     uint evaluate = 0u, traverse = 0u;
     // Depth-first from each root, without a stack (as gather.frag's
     // traverse_from), so the entries come in the same order every frame.
@@ -112,21 +111,22 @@ void main() {
         for (;;) {
             LightPatch lp = nodes[node_index(node)];
             if (lp.position_area.w > 0.0) {  // else: saw nothing
-                bool deeper = node.z < max_depth;
-                float reach = deeper ? hisr_reach(lp, node) : -1.0;
+                // flux.a: the squared reach, -1 at the max depth (hisr_reach).
+                float reach = lp.flux.a;
                 vec3 p = lp.position_area.xyz;
                 vec3 far = max(abs(p - lo), abs(p - hi));
-                if (deeper && dot(far, far) <= reach) {
+                if (dot(far, far) <= reach) {
                     node = ivec3(2 * node.xy, node.z + 1);
                     continue;
                 }
                 vec3 near = max(max(lo - p, p - hi), vec3(0.0));
-                bool disagree = deeper && dot(near, near) <= reach;
-                // Evaluate entries from the front of the range, traverse
-                // entries from the back; they must not meet.
+                bool disagree = dot(near, near) <= reach;
+                // Evaluate entries (packed indices) from the front of the
+                // range, traverse entries (cut_entry) from the back; they
+                // must not meet.
                 if (evaluate + traverse < capacity) {
                     uint at = disagree ? base + capacity - 1u - traverse : base + evaluate;
-                    cut[at] = cut_entry(node);
+                    cut[at] = disagree ? cut_entry(node) : uint(node_index(node));
                 }
                 if (disagree) {
                     ++traverse;

@@ -2,13 +2,18 @@
 // Pass `light-tree-pack` (HISR, docs/algorithm.md section 4): copies the RSM
 // quadtree's mip chains into one storage buffer, a LightPatch per node, so the
 // per-fragment traversal reads a node with one contiguous load instead of
-// three texel fetches from three mip chains.
+// three texel fetches from three mip chains. Each node's flux.a (the summed
+// solid angle, which HISR does not read) becomes its squared reach
+// (hisr_reach in hisr.glsl): the split test is one comparison per node, and
+// the per-node bound is computed once per frame instead of per fragment.
 //
 // Order: depth-major from the root. Depth d (2^d x 2^d patches, RSM mip
 // top - d) starts at node (4^d - 1) / 3, row-major inside: node (x, y) of depth
 // d is (4^d - 1) / 3 + y 2^d + x. One invocation per node, laid out R wide.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
+#include "light_types.glsl"
+#include "hisr.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
@@ -36,6 +41,8 @@ void main() {
     int side = 1 << d;
     ivec2 xy = ivec2(node % side, node / side);
     int mip = top - d;
-    nodes[i] = LightPatch(texelFetch(rsm_position, xy, mip), texelFetch(rsm_normal, xy, mip),
-                          texelFetch(rsm_flux, xy, mip));
+    LightPatch lp = LightPatch(texelFetch(rsm_position, xy, mip), texelFetch(rsm_normal, xy, mip),
+                               texelFetch(rsm_flux, xy, mip));
+    lp.flux.a = hisr_reach(lp, ivec3(xy, d));
+    nodes[i] = lp;
 }

@@ -65,7 +65,8 @@ struct LightPatch {
     vec4 position_area;  // xyz: area-weighted mean position (m); w: area A (m^2)
     vec4 normal;         // xyz: unit mean normal; w: RSM quadtree level (ISR's list) or
                          // PATCH_* (HISR's packed tree)
-    vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr)
+    vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr), or
+                         // the squared reach (hisr_reach, HISR's packed tree)
 };
 
 // RSM quadtree normal.w: what a patch is.
@@ -82,7 +83,8 @@ const float HISR_INVALID_TAU_SCALE = 0.01;
 // side; the coarsest is cut from the start depth, each finer one from its
 // parent tile's "traverse" entries. Layout of the buffer (hisr_cut.comp
 // writes it, gather.frag reads it): this header, then per level a count per
-// tile, then per level `capacity` entries per tile (cut_entry in hisr.glsl):
+// tile, then per level `capacity` entries per tile (hisr.glsl: packed indices
+// for evaluate entries, cut_entry for traverse entries):
 // a tile's "evaluate" entries from the front of its range, its "traverse"
 // entries from the back. A count holds the evaluate entries in bits 0-15 and
 // the traverse entries in bits 16-31, or is HISR_CUT_OVERFLOW. Offsets count

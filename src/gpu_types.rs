@@ -86,7 +86,7 @@ pub struct LightPatch {
     pub position_area: [f32; 4],
     /// xyz: mean normal; w: quadtree level (RSM mip).
     pub normal: [f32; 4],
-    /// rgb: flux; a: solid angle.
+    /// rgb: flux; a: solid angle (in HISR's packed tree: the squared reach).
     pub flux: [f32; 4],
 }
 
@@ -111,6 +111,10 @@ pub struct HisrCutHeader {
 
 /// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.
 pub const HISR_CUT_OVERFLOW: u32 = u32::MAX;
+
+/// HISR splits an invalid patch while its bound could exceed tau times this,
+/// as in `shaders/shared.glsl`.
+pub const HISR_INVALID_TAU_SCALE: f32 = 0.01;
 
 /// RSM quadtree `normal.w` values, as in `shaders/shared.glsl`.
 pub const PATCH_EMPTY: f32 = 0.0;

@@ -2,7 +2,8 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
+    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu,
+    RunUniforms, HISR_INVALID_TAU_SCALE,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
@@ -243,6 +244,7 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(float("PATCH_EMPTY"), PATCH_EMPTY);
     assert_eq!(float("PATCH_VALID"), PATCH_VALID);
     assert_eq!(float("PATCH_INVALID"), PATCH_INVALID);
+    assert_eq!(float("HISR_INVALID_TAU_SCALE"), HISR_INVALID_TAU_SCALE);
 }
 
 #[test]

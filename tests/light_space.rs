@@ -4,6 +4,7 @@ mod common;
 
 use common::*;
 use glam::Vec3;
+use isr::gpu_types::{HISR_INVALID_TAU_SCALE, PATCH_INVALID};
 use isr::multires::MultiresSettings;
 use isr::scene::{cornell::cornell_box, Camera};
 use isr::settings::{LightTreeSettings, Method, RenderSettings};
@@ -279,22 +280,34 @@ fn stats_and_vpl_count_view_from_the_cli() {
 
 /// HISR traverses the quadtree packed into one buffer: node (x, y) of depth d
 /// at (4^d - 1) / 3 + y 2^d + x holds exactly the quadtree texel of mip
-/// log2 R - d (position and area, normal and state, flux and solid angle).
+/// log2 R - d (position and area, normal and state, flux), and in flux.a its
+/// squared reach (`hisr_reach`): for the spot light 4^k T |p - light|^2, k its
+/// levels above the finest, divided by HISR_INVALID_TAU_SCALE for invalid
+/// patches; -1 at the max depth and for empty nodes.
 #[test]
 fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
     let gpu = gpu();
     let rsm = 32u32;
-    let s = settings(Method::Hisr, rsm, LightTreeSettings::default());
-    let mut r = isr::renderer::Renderer::new(&gpu, &cornell_box(), &s).unwrap();
+    let scene = cornell_box();
+    let lt = LightTreeSettings {
+        max_depth: Some(4),
+        ..Default::default()
+    };
+    let s = settings(Method::Hisr, rsm, lt);
+    let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
     let packed = r.hisr_packed_tree().unwrap().expect("hisr packs its tree");
     let m = r.readback_multires().unwrap().unwrap();
     drop(r);
     assert_validation_clean(&gpu);
     let top = rsm.trailing_zeros() as usize;
+    let max_depth = s.hisr_max_depth() as usize;
+    assert!(max_depth < top, "some depths should never split");
+    let t = isr::methods::hisr::subdivision_threshold(s.light_tree.tau, rsm) as f64;
+    let light = scene.lights[0].position.as_dvec3();
     assert_eq!(packed.len(), ((4 * rsm * rsm - 1) / 3) as usize);
     let mut index = 0;
-    let mut lit = 0;
+    let (mut lit, mut invalid) = (0, 0);
     for d in 0..=top {
         let side = 1usize << d;
         let [pos, nrm, flux] = &m.rsm_tree[top - d];
@@ -302,12 +315,33 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
             let n = &packed[index + i];
             assert_eq!(n.position_area, pos[i], "depth {d} node {i} position");
             assert_eq!(n.normal, nrm[i], "depth {d} node {i} normal");
-            assert_eq!(n.flux, flux[i], "depth {d} node {i} flux");
+            assert_eq!(n.flux[..3], flux[i][..3], "depth {d} node {i} flux");
+            let reach = if d >= max_depth || pos[i][3] <= 0.0 {
+                -1.0
+            } else {
+                let p = glam::DVec3::new(pos[i][0] as f64, pos[i][1] as f64, pos[i][2] as f64);
+                let scale = if nrm[i][3] == PATCH_INVALID {
+                    invalid += 1;
+                    1.0 / HISR_INVALID_TAU_SCALE as f64
+                } else {
+                    1.0
+                };
+                4f64.powi((top - d) as i32) * t * (p - light).length_squared() * scale
+            };
+            let got = n.flux[3] as f64;
+            assert!(
+                (got - reach).abs() <= 1e-5 * reach.abs(),
+                "depth {d} node {i}: reach {got}, expected {reach}"
+            );
             lit += (pos[i][3] > 0.0) as usize;
         }
         index += side * side;
     }
     assert!(lit > 100, "only {lit} nodes saw anything");
+    assert!(
+        invalid > 0,
+        "no invalid node above the max depth was checked"
+    );
 }
 
 /// HISR's per-tile cuts (`hisr-cut`, docs/algorithm.md section 4.4) change
