@@ -98,8 +98,14 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
     ivec3 node = root;  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     for (;;) {
         LightPatch lp = patches[node_index(node)];
+        // Empty nodes (saw nothing) are skipped before the split test, although
+        // their reach (-1) never splits: with the test first, lavapipe shaded the
+        // fragments of silhouette columns as if no node split (the tile-cut test
+        // catches it; the cause was not found).
         if (lp.position_area.w > 0.0) {
             vec3 vij = lp.position_area.xyz - xi;
+            // flux.a: the squared reach, -1 at the max depth (hisr_reach,
+            // stored by light-tree-pack).
             if (dot(vij, vij) <= lp.flux.a) {
                 node = ivec3(2 * node.xy, node.z + 1);
                 continue;
