@@ -17,9 +17,9 @@
 // The box is padded by a little more than float rounding so that a receiver
 // on its surface is decided alike too.
 //
-// One dispatch per chained level (HISR_CUT_LEVELS, coarsest first), one
-// invocation per tile, depth-first without a stack, entries written in
-// traversal order (so the gather's sums come in the same order every
+// One dispatch for the finest tiles' boxes (BOXES), then one per chained
+// level (HISR_CUT_LEVELS, coarsest first), one invocation per tile,
+// depth-first without a stack, entries written in traversal order (so the gather's sums come in the same order every
 // frame). A finer tile lies inside its parent, so its box does too, and its
 // cut only refines the parent's traverse entries. A tile whose list does not
 // fit, or whose parent's did not, is marked HISR_CUT_OVERFLOW and its
@@ -46,20 +46,52 @@ layout(push_constant) uniform Push {
     int level;              // the cut level c this dispatch makes
 };
 
-// The box of tile `tile`'s positions, padded (see above); lo.x > hi.x if it
-// has none.
-void tile_box(ivec2 tile, out vec3 lo, out vec3 hi) {
-    int side = 1 << layout_.tiles[level].z;
+// BOXES: the dispatch before the cuts, one invocation per finest tile, writes
+// the (unpadded) box of its positions; the cut dispatches take a tile's box as
+// the union of its finest tiles' boxes (min and max are exact, so it is the
+// box of its positions), so each G-buffer position is read once, not once per
+// level (the coarsest level's few invocations each read 4096 of them).
+layout(constant_id = 0) const bool BOXES = false;
+
+const vec3 EMPTY_LO = vec3(3.0e38);
+const vec3 EMPTY_HI = vec3(-3.0e38);
+
+// Finest tile t's box, at entries.x: lo.xyz, pad, hi.xyz, pad (float bits).
+uint box_at(uint t) { return layout_.entries.x + 8u * t; }
+
+void write_finest_box(ivec2 tile) {
+    int side = 1 << layout_.tiles[0].z;
     ivec2 origin = tile * side;
     ivec2 end = min(origin + side, ivec2(run.size.xy));
-    lo = vec3(3.0e38);
-    hi = vec3(-3.0e38);
+    vec3 lo = EMPTY_LO, hi = EMPTY_HI;
     for (int y = origin.y; y < end.y; ++y) {
         for (int x = origin.x; x < end.x; ++x) {
             vec4 p = texelFetch(gbuffer_position, ivec2(x, y), 0);
             if (p.w <= 0.0) continue;
             lo = min(lo, p.xyz);
             hi = max(hi, p.xyz);
+        }
+    }
+    uint at = box_at(uint(tile.y) * layout_.tiles[0].x + uint(tile.x));
+    for (int k = 0; k < 3; ++k) {
+        cut[at + k] = floatBitsToUint(lo[k]);
+        cut[at + 4 + k] = floatBitsToUint(hi[k]);
+    }
+}
+
+// The box of tile `tile` of this level, padded (see above); lo.x > hi.x if it
+// has no positions.
+void tile_box(ivec2 tile, out vec3 lo, out vec3 hi) {
+    int n = 1 << level;  // finest tiles per side
+    ivec2 origin = tile * n;
+    ivec2 end = min(origin + n, ivec2(layout_.tiles[0].xy));
+    lo = EMPTY_LO;
+    hi = EMPTY_HI;
+    for (int y = origin.y; y < end.y; ++y) {
+        for (int x = origin.x; x < end.x; ++x) {
+            uint at = box_at(uint(y) * layout_.tiles[0].x + uint(x));
+            lo = min(lo, uintBitsToFloat(uvec3(cut[at], cut[at + 1], cut[at + 2])));
+            hi = max(hi, uintBitsToFloat(uvec3(cut[at + 4], cut[at + 5], cut[at + 6])));
         }
     }
     vec3 m = max(abs(lo), abs(hi));
@@ -72,6 +104,10 @@ void main() {
     uvec4 lv = layout_.tiles[level];
     uint capacity = layout_.capacity[level];
     ivec2 tile = ivec2(gl_GlobalInvocationID.xy);
+    if (BOXES) {
+        if (all(lessThan(tile, ivec2(layout_.tiles[0].xy)))) write_finest_box(tile);
+        return;
+    }
     if (level == 0 && tile == ivec2(0)) header = layout_;
     if (any(greaterThanEqual(tile, ivec2(lv.xy)))) return;
     uint t = uint(tile.y) * lv.x + uint(tile.x);

@@ -93,7 +93,8 @@ const int HISR_CUT_LEVELS = 3;
 struct HisrCutHeader {
     uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
                                    // level K + c; w: offset of its counts
-    uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: unused
+    uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: of the
+                                   // finest tiles' boxes (8 floats each, hisr_cut.comp)
     uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
 };
 

@@ -99,7 +99,8 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// `HisrCutHeader` (std430): the head of HISR's per-tile cut buffer
 /// (`shaders/hisr_cut.comp`): per level, tiles per row and column, tile level
 /// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
-/// and its entries per tile (`capacity[c]`); offsets in `u32`s after the
+/// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
+/// `entries[0]` (8 floats a tile); offsets in `u32`s after the
 /// header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

@@ -107,6 +107,9 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
         *level = [tx, ty, k + c as u32, offset as u32];
         offset += tiles[c];
     }
+    // The finest tiles' boxes (8 floats each).
+    header.entries[0] = offset as u32;
+    offset += 8 * tiles[0];
     let full: u64 = (0..HISR_CUT_LEVELS)
         .map(|c| tiles[c] * CUT_CAPACITY[c])
         .sum();
@@ -133,14 +136,18 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
             t[0] as u64 * t[1] as u64 * (1 + header.capacity[c] as u64)
         })
         .sum();
-    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * entries
+    let [tx, ty, ..] = header.tiles[0];
+    let boxes = 8 * tx as u64 * ty as u64;
+    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes)
 }
 
 /// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
-/// one dispatch per chained level, coarsest first, one invocation per
-/// eye-space tile. Reads the G-buffer positions, the packed tree and the
-/// coarser level's cuts; writes the cut buffer (barriers in `record`).
+/// one dispatch for the finest tiles' boxes of G-buffer positions, then one
+/// per chained level, coarsest first, one invocation per eye-space tile.
+/// Reads the G-buffer positions, the packed tree, the boxes and the coarser
+/// level's cuts; writes the cut buffer (barriers in `record`).
 struct CutPass {
+    boxes: ComputePass,
     pass: ComputePass,
     buffer: Buffer,
     header: HisrCutHeader,
@@ -163,16 +170,20 @@ impl CutPass {
             Binding::storage("HisrCut", &buffer),
         ];
         let push_bytes = std::mem::size_of::<HisrCutHeader>() as u32 + 4;
-        let pass = ComputePass::new(
-            setup,
-            "hisr-cut",
-            "hisr_cut.comp",
-            &[bindings],
-            push_bytes,
-            &[],
-        )?;
+        // Specialisation constant 0 (BOXES): the boxes' dispatch or the cuts'.
+        let pass = |boxes: bool| {
+            ComputePass::new(
+                setup,
+                "hisr-cut",
+                "hisr_cut.comp",
+                std::slice::from_ref(&bindings),
+                push_bytes,
+                &[(0, boxes as i32)],
+            )
+        };
         Ok(Self {
-            pass,
+            boxes: pass(true)?,
+            pass: pass(false)?,
             buffer,
             header,
         })
@@ -193,13 +204,21 @@ impl CutPass {
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             );
-            for c in (0..HISR_CUT_LEVELS).rev() {
-                if c + 1 < HISR_CUT_LEVELS {
-                    // Level c reads level c + 1's cuts.
-                    barrier::compute_to_compute(gpu, cmd);
-                }
+            let push = |c: usize| {
                 let mut push = bytemuck::bytes_of(&self.header).to_vec();
                 push.extend_from_slice(&(c as i32).to_ne_bytes());
+                push
+            };
+            let [tx, ty, ..] = self.header.tiles[0];
+            let finest = vk::Extent2D {
+                width: tx,
+                height: ty,
+            };
+            self.boxes.dispatch(ctx, 0, &push(0), finest);
+            for c in (0..HISR_CUT_LEVELS).rev() {
+                // Level c reads the boxes and level c + 1's cuts.
+                barrier::compute_to_compute(gpu, cmd);
+                let push = push(c);
                 // One invocation per tile.
                 let [tx, ty, ..] = self.header.tiles[c];
                 let extent = vk::Extent2D {
