@@ -2,8 +2,7 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu,
-    RunUniforms, HISR_INVALID_TAU_SCALE,
+    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
