@@ -20,10 +20,11 @@
 // One dispatch for the finest tiles' boxes (BOXES), then one per chained
 // level (HISR_CUT_LEVELS, coarsest first), one invocation per tile,
 // depth-first without a stack, entries written in traversal order (so the
-// gather's sums come in the same order every frame). A finer tile lies inside its parent, so its box does too, and its
-// cut only refines the parent's traverse entries. A tile whose list does not
-// fit, or whose parent's did not, is marked HISR_CUT_OVERFLOW and its
-// fragments traverse from the roots (same result, slower).
+// gather's sums come in the same order every frame). A finer tile lies
+// inside its parent, so its box does too, and its cut only refines the
+// parent's traverse entries. A tile whose list does not fit, or whose
+// parent's did not, is marked HISR_CUT_OVERFLOW and its fragments traverse
+// from the roots (same result, slower).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "light_types.glsl"
