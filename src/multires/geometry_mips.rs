@@ -1,98 +1,151 @@
 //! Pass `geometry-mips`: levels 1..=L of the geometry mipmaps (docs/algorithm.md
-//! section 3, steps 2-4) with `shaders/geometry_mips.comp`, one dispatch per
-//! level (level 0 is the G-buffer itself). Reads the G-buffer; writes `geo_*`
-//! (barriers below).
+//! section 3, steps 2-4), one full-screen draw per level into that level's mip
+//! of the five chains (level 0 is the G-buffer itself):
+//! `shaders/geometry_level_one.frag` reads the G-buffer,
+//! `shaders/geometry_mips.frag` level l - 1 (`shaders/geometry_mips.glsl`).
+//! Reads the G-buffer; writes `geo_*` (barriers below).
 
 use super::MultiresBuffer;
 use crate::frame::{FrameContext, Setup};
-use crate::passes::{ComputePass, INDIRECT_COMPUTE};
+use crate::passes::{begin_rendering, Attachments, INDIRECT_GRAPHICS};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::Binding;
+use crate::vk::descriptors::DescriptorSet;
+use crate::vk::pipeline::{Binding, GraphicsDesc, Pipeline};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
+use ash::vk;
 
-/// Level 1 and the levels above are separate pipelines (`geometry_mips.comp`'s
-/// specialisation constant LEVEL_ONE): CPU drivers execute every branch under
-/// a lane mask, so one pipeline would run the reads of both for every texel.
+/// Level 1 and the levels above are separate shaders: CPU drivers execute
+/// every branch under a lane mask, so one shader would run the reads of both
+/// for every texel.
 pub struct GeometryMipsPass {
-    level_one: ComputePass,
+    level_one: Pipeline,
+    level_one_set: DescriptorSet,
     /// Levels 2..=L, one descriptor set each (none with L = 1).
-    above: Option<ComputePass>,
+    above: Option<(Pipeline, Vec<DescriptorSet>)>,
 }
 
-const LEVEL_ONE: u32 = 0;
-
-/// Shader names of the five chains' source (`src_*`) and destination (`dst_*`)
-/// bindings, in `MultiresBuffer::geometry_images` order.
+/// Shader names of the five chains' source bindings, in
+/// `MultiresBuffer::geometry_images` order (the outputs are in that order too).
 const SOURCES: [&str; 5] = ["src_mean", "src_normal", "src_min", "src_max", "src_flags"];
-const DESTINATIONS: [&str; 5] = ["dst_mean", "dst_normal", "dst_min", "dst_max", "dst_flags"];
 
 impl GeometryMipsPass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
-        let (t, s) = (setup.targets, setup.samplers);
+        let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let images = m.geometry_images();
-        let levels = m.levels as usize;
-        // Every chain holds levels 1..=L (mip m is level m + 1; level 0 is
-        // the G-buffer). Level 1 reads the G-buffer, so its source bindings
-        // are unused and point at a mip it does not write (the last one).
-        let mip_of = |level: usize| level.checked_sub(1).unwrap_or(levels - 1);
-        let bindings = |l: usize| {
-            let mut b = vec![
-                Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
-                Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
-            ];
-            for (names, level) in [(SOURCES, l - 1), (DESTINATIONS, l)] {
-                b.extend(
-                    images
-                        .iter()
-                        .zip(names)
-                        .map(|(i, name)| Binding::storage_image(name, i.mip_views[mip_of(level)])),
-                );
-            }
-            b
-        };
-        let pass = |level_one: bool, variants: Vec<Vec<Binding>>| {
-            ComputePass::new(
-                setup,
-                "geometry-mips",
-                "geometry_mips.comp",
-                &variants,
-                0,
-                &[(LEVEL_ONE, level_one as i32)],
+        let color_formats = images.map(|i| i.format);
+        let pipeline = |shader: &str, set: &DescriptorSet| {
+            Pipeline::graphics(
+                gpu,
+                &GraphicsDesc {
+                    name: "geometry-mips",
+                    fragment_shader: shader,
+                    sets: &[setup.frame, set],
+                    color_formats: &color_formats,
+                    ..Default::default()
+                },
             )
         };
+        let level_one_set = DescriptorSet::new(
+            gpu,
+            "geometry-mips",
+            &[
+                Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+            ],
+        )?;
+        // Level l (2..=L) reads mip l - 2, level l - 1 (mip m is level m + 1).
+        let above_sets = (2..=m.levels as usize)
+            .map(|l| {
+                let bindings: Vec<_> = images
+                    .iter()
+                    .zip(SOURCES)
+                    .map(|(i, name)| Binding::storage_image(name, i.mip_views[l - 2]))
+                    .collect();
+                DescriptorSet::new(gpu, "geometry-mips", &bindings)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let above = match above_sets.first() {
+            Some(first) => Some((pipeline("geometry_mips.frag", first)?, above_sets)),
+            None => None,
+        };
         Ok(Self {
-            level_one: pass(true, vec![bindings(1)])?,
-            above: match levels {
-                1 => None,
-                _ => Some(pass(false, (2..=levels).map(bindings).collect())?),
-            },
+            level_one: pipeline("geometry_level_one.frag", &level_one_set)?,
+            level_one_set,
+            above,
         })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let images = m.geometry_images();
-        profiler.pass(gpu, cmd, "geometry-mips", INDIRECT_COMPUTE, || {
+        profiler.pass(gpu, cmd, "geometry-mips", INDIRECT_GRAPHICS, || {
             barrier::transition(
                 gpu,
                 cmd,
                 &images,
                 Use::DISCARD_AFTER_READERS,
-                Use::COMPUTE_STORAGE,
+                Use::COLOR_ATTACHMENT,
             );
-            for level in 1..=m.levels as usize {
+            for level in 1..=m.levels {
+                let mip = level - 1;
                 if level > 1 {
-                    barrier::compute_to_compute(gpu, cmd);
+                    // The previous level, written as attachments, is read
+                    // as storage images by this draw.
+                    let before: Vec<_> = images
+                        .iter()
+                        .map(|i| {
+                            barrier::mips(
+                                i,
+                                mip - 1,
+                                1,
+                                Use::COLOR_ATTACHMENT,
+                                Use::FRAGMENT_STORAGE,
+                            )
+                        })
+                        .collect();
+                    barrier::images(gpu, cmd, &before);
                 }
-                let extent = m.level_extent(level as u32);
-                match (level, &self.above) {
-                    (1, _) => self.level_one.dispatch(ctx, 0, &[], extent),
-                    (_, Some(above)) => above.dispatch(ctx, level - 2, &[], extent),
+                let views = images.map(|i| i.mip_views[mip as usize]);
+                begin_rendering(
+                    gpu,
+                    cmd,
+                    &Attachments {
+                        // Every texel is written: nothing to clear.
+                        clear_colors: false,
+                        ..Attachments::simple(&views, None, m.level_extent(level))
+                    },
+                );
+                let (pipeline, set) = match (level, &self.above) {
+                    (1, _) => (&self.level_one, &self.level_one_set),
+                    (_, Some((above, sets))) => (above, &sets[level as usize - 2]),
                     (_, None) => unreachable!("levels above 1 have their pipeline"),
+                };
+                pipeline.bind(
+                    gpu,
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    &[ctx.frame_set, set.set],
+                );
+                unsafe {
+                    gpu.device.cmd_draw(cmd, 3, 1, 0, 0);
+                    gpu.device.cmd_end_rendering(cmd);
                 }
             }
-            barrier::transition(gpu, cmd, &images, Use::COMPUTE_STORAGE, Use::READ_ONLY);
+            // Mips 0..L-2 were last read as storage images, mip L-1 written.
+            let last = m.levels - 1;
+            let mut after: Vec<_> = images
+                .iter()
+                .map(|i| barrier::mips(i, last, 1, Use::COLOR_ATTACHMENT, Use::READ_ONLY))
+                .collect();
+            if last > 0 {
+                after.extend(
+                    images
+                        .iter()
+                        .map(|i| barrier::mips(i, 0, last, Use::FRAGMENT_STORAGE, Use::READ_ONLY)),
+                );
+            }
+            barrier::images(gpu, cmd, &after);
         });
     }
 }

@@ -52,12 +52,18 @@ impl MultiresBuffer {
                     | vk::FormatFeatureFlags::TRANSFER_SRC,
             )
             .ok_or_else(|| anyhow!("the device has no stencil format usable as an attachment"))?;
-        // geometry_mips.comp binds ten storage images (Vulkan guarantees four per
-        // stage), and the refinement counts patches with fragment-shader atomics.
-        let storage_images = gpu.limits().max_per_stage_descriptor_storage_images;
-        if storage_images < 10 {
+        // geometry_mips.frag reads five storage images and writes five color
+        // attachments (Vulkan guarantees four of each per fragment stage).
+        let limits = gpu.limits();
+        let (storage_images, colors, outputs) = (
+            limits.max_per_stage_descriptor_storage_images,
+            limits.max_color_attachments,
+            limits.max_fragment_combined_output_resources,
+        );
+        if storage_images < 5 || colors < 5 || outputs < 10 {
             bail!(
-                "{} allows {storage_images} storage images per shader stage; the geometry mips need 10. \
+                "{} allows {storage_images} storage images per stage, {colors} color attachments and \
+                 {outputs} fragment output resources; the geometry mips need 5, 5 and 10. \
                  Choose another --device or --method none",
                 gpu.info.name
             );
@@ -107,7 +113,8 @@ impl MultiresBuffer {
                     },
                     layers: 1,
                     mips: levels,
-                    usage: storage,
+                    // Written as attachments (geometry_mips.glsl).
+                    usage: storage | vk::ImageUsageFlags::COLOR_ATTACHMENT,
                 },
             )
         };
