@@ -29,6 +29,10 @@ pub struct MultiresBuffer {
     pub geo_min: Image,
     pub geo_max: Image,
     pub geo_flags: Image,
+    /// What the upsampling's push into level l - 1 reads of each level-l texel
+    /// (l >= 1): its value and its relation to its neighbours, in layer l % 2
+    /// (`upsample.comp`, `store_tap`). Two layers of level 1's size.
+    pub upsample_taps: Image,
     /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.comp`).
     pub illumination: Image,
     /// Light patches each eye-space patch evaluated (a count in R32_SFLOAT, so
@@ -126,6 +130,20 @@ impl MultiresBuffer {
             geo_min: chain("geo_min", rgba)?,
             geo_max: chain("geo_max", rgba)?,
             geo_flags: chain("geo_flags", vk::Format::R32_UINT)?,
+            upsample_taps: Image::new(
+                gpu,
+                &ImageDesc {
+                    name: "upsample_taps",
+                    format: rgba,
+                    extent: vk::Extent2D {
+                        width: (width >> 1).max(1),
+                        height: (height >> 1).max(1),
+                    },
+                    layers: 2,
+                    mips: 1,
+                    usage: vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED,
+                },
+            )?,
             illumination: layered(
                 "illumination",
                 rgba,

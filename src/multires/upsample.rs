@@ -1,29 +1,37 @@
 //! Pass `upsample`: the illumination buffer to a full-resolution indirect image
-//! (docs/algorithm.md section 3, step 7), `shaders/upsample.comp`: a pull from
-//! level 1 up to L, then a push from L - 1 down to 0, which writes `indirect`
-//! (nearest or interpolated, by a specialisation constant).
+//! (docs/algorithm.md section 3, step 7): a pull from level 1 up to L and a push
+//! from L - 1 down to 1 (`shaders/upsample.comp`), then the push into level 0
+//! as a full-screen draw into `indirect` (`shaders/upsample_level0.frag`),
+//! nearest or interpolated by a specialisation constant. The dispatch that
+//! finalises a level l >= 1 (the pull of L, every push) writes the taps the
+//! push into l - 1 reads (`upsample_taps`, `shaders/upsample.glsl`).
 //! Reads the illumination buffer and geometry mips; writes `indirect`.
 
 use super::{MultiresBuffer, Upsample};
 use crate::frame::{FrameContext, Setup};
-use crate::passes::{ComputePass, INDIRECT_COMPUTE};
+use crate::passes::{begin_rendering, Attachments, ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::Binding;
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
 /// One pipeline per kind of dispatch (`upsample.comp`'s specialisation
 /// constants): CPU drivers execute every branch of a shader under a lane mask,
-/// so one shader for all three would run all three's code per invocation.
+/// so one shader for all kinds would run all their code per invocation.
 pub struct UpsamplePass {
     pull: ComputePass,
+    /// The pull into level L, which also writes its taps.
+    pull_coarsest: ComputePass,
+    /// The push into a level 1..L-1 (with its taps).
     push: ComputePass,
-    push_level_zero: ComputePass,
+    /// The push into level 0, writing `indirect`.
+    level_zero: PassPipeline,
 }
 
-/// Specialisation constant ids of `upsample.comp`.
+/// Specialisation constant ids of `upsample.comp` (INTERPOLATE also of
+/// `upsample_level0.frag`).
 const PULL: u32 = 0;
-const LEVEL_ZERO: u32 = 1;
+const WRITE_TAPS: u32 = 1;
 const INTERPOLATE: u32 = 2;
 
 impl UpsamplePass {
@@ -33,13 +41,11 @@ impl UpsamplePass {
             Binding::storage_image("illumination", m.illumination.view),
             Binding::sampled("geo_mean", m.geo_mean.view, s.nearest),
             Binding::sampled("geo_normal", m.geo_normal.view, s.nearest),
-            Binding::storage_image("indirect", t.indirect.view),
-            Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
-            Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+            Binding::storage_image("taps", m.upsample_taps.view),
         ];
         // From these settings; a change of settings rebuilds the passes.
         let interpolate = (setup.settings.multires.upsample == Upsample::Interpolated) as i32;
-        let pass = |pull: bool, level_zero: bool| {
+        let pass = |pull: bool, taps: bool| {
             ComputePass::new(
                 setup,
                 "upsample",
@@ -48,15 +54,31 @@ impl UpsamplePass {
                 4,
                 &[
                     (PULL, pull as i32),
-                    (LEVEL_ZERO, level_zero as i32),
+                    (WRITE_TAPS, taps as i32),
                     (INTERPOLATE, interpolate),
                 ],
             )
         };
+        let level_zero = PassPipeline::graphics(
+            setup.gpu,
+            setup.frame,
+            &[
+                Binding::storage_image("illumination", m.illumination.view),
+                Binding::storage_image("taps", m.upsample_taps.view),
+            ],
+            GraphicsDesc {
+                name: "upsample",
+                fragment_shader: "upsample_level0.frag",
+                color_formats: &[t.indirect.format],
+                specialization: &[(INTERPOLATE, interpolate)],
+                ..Default::default()
+            },
+        )?;
         Ok(Self {
             pull: pass(true, false)?,
-            push: pass(false, false)?,
-            push_level_zero: pass(false, true)?,
+            pull_coarsest: pass(true, true)?,
+            push: pass(false, true)?,
+            level_zero,
         })
     }
 
@@ -69,7 +91,7 @@ impl UpsamplePass {
                 &[
                     barrier::image(&m.illumination, Use::READ_ONLY, Use::COMPUTE_STORAGE),
                     barrier::image(
-                        &t.indirect,
+                        &m.upsample_taps,
                         Use::DISCARD_AFTER_READERS,
                         Use::COMPUTE_STORAGE,
                     ),
@@ -81,10 +103,10 @@ impl UpsamplePass {
                     barrier::compute_to_compute(gpu, cmd);
                 }
                 first = false;
-                let pass = match (pull, level) {
-                    (true, _) => &self.pull,
-                    (false, 0) => &self.push_level_zero,
-                    (false, _) => &self.push,
+                let pass = match pull {
+                    true if level == m.levels => &self.pull_coarsest,
+                    true => &self.pull,
+                    false => &self.push,
                 };
                 let push = (level as i32).to_ne_bytes();
                 pass.dispatch(ctx, 0, &push, m.level_extent(level));
@@ -92,15 +114,45 @@ impl UpsamplePass {
             for level in 1..=m.levels {
                 run(level, true);
             }
-            for level in (0..m.levels).rev() {
+            for level in (1..m.levels).rev() {
                 run(level, false);
             }
-            barrier::transition(
+            // Level 0: the fragment shader reads what the dispatches wrote.
+            barrier::images(
                 gpu,
                 cmd,
-                &[&m.illumination, &t.indirect],
-                Use::COMPUTE_STORAGE,
-                Use::READ_ONLY,
+                &[
+                    barrier::image(&m.illumination, Use::COMPUTE_STORAGE, Use::FRAGMENT_STORAGE),
+                    barrier::image(
+                        &m.upsample_taps,
+                        Use::COMPUTE_STORAGE,
+                        Use::FRAGMENT_STORAGE,
+                    ),
+                    barrier::image(
+                        &t.indirect,
+                        Use::DISCARD_AFTER_READERS,
+                        Use::COLOR_ATTACHMENT,
+                    ),
+                ],
+            );
+            begin_rendering(
+                gpu,
+                cmd,
+                &Attachments::simple(&[t.indirect.view], None, t.indirect.extent),
+            );
+            self.level_zero.bind(gpu, cmd, ctx.frame_set);
+            unsafe {
+                gpu.device.cmd_draw(cmd, 3, 1, 0, 0);
+                gpu.device.cmd_end_rendering(cmd);
+            }
+            barrier::images(
+                gpu,
+                cmd,
+                &[
+                    barrier::image(&m.illumination, Use::FRAGMENT_STORAGE, Use::READ_ONLY),
+                    barrier::image(&m.upsample_taps, Use::FRAGMENT_STORAGE, Use::READ_ONLY),
+                    barrier::image(&t.indirect, Use::COLOR_ATTACHMENT, Use::READ_ONLY),
+                ],
             );
         });
     }
