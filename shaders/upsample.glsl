@@ -7,7 +7,8 @@
 
 // Texel alpha in the illumination buffer: 1 = a patch the gather shaded;
 // 0.5 = pulled (the mean of its children, for texels split into finer
-// patches); 0.75 = pushed (from the coarser level); 0 = no value (yet).
+// patches); 0 = no value (yet). 0.75 = pushed (from the coarser level), a
+// value that goes only to the taps and to `indirect`, never to the buffer.
 const float PULLED = 0.5;
 const float PUSHED = 0.75;
 
@@ -19,9 +20,10 @@ bool inside(ivec2 q, int l) { return all(greaterThanEqual(q, ivec2(0))) && all(l
 // texel per texel of l into `taps` (layer l % 2): rgb its value, alpha these
 // bits (small integers, exact in a float). The texel holds a value; it is on
 // the same surface as its neighbour E (x + 1, y), S (x, y + 1), SE (x + 1,
-// y + 1), SW (x - 1, y + 1); it is fully covered (coverage 1). A 2x2 footprint's four taps then hold every
-// pair's relation, so the push into l - 1 reads one texel per tap and tests
-// nothing: on CPU drivers the fetches and tests were its cost.
+// y + 1), SW (x - 1, y + 1); it is fully covered (coverage 1). A 2x2
+// footprint's four taps then hold every pair's relation, so the push into
+// l - 1 reads one texel per tap and tests nothing: on CPU drivers the fetches
+// and tests were its cost.
 const uint TAP_VALUE = 1u;
 const uint TAP_E = 2u;
 const uint TAP_S = 4u;
