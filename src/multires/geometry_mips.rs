@@ -10,7 +10,7 @@ use crate::frame::{FrameContext, Setup};
 use crate::passes::{begin_rendering, Attachments, INDIRECT_GRAPHICS};
 use crate::vk::barrier::{self, Use};
 use crate::vk::descriptors::DescriptorSet;
-use crate::vk::pipeline::{Binding, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, Pipeline};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 use ash::vk;
@@ -19,8 +19,7 @@ use ash::vk;
 /// every branch under a lane mask, so one shader would run the reads of both
 /// for every texel.
 pub struct GeometryMipsPass {
-    level_one: Pipeline,
-    level_one_set: DescriptorSet,
+    level_one: PassPipeline,
     /// Levels 2..=L, one descriptor set each (none with L = 1).
     above: Option<(Pipeline, Vec<DescriptorSet>)>,
 }
@@ -34,25 +33,20 @@ impl GeometryMipsPass {
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let images = m.geometry_images();
         let color_formats = images.map(|i| i.format);
-        let pipeline = |shader: &str, set: &DescriptorSet| {
-            Pipeline::graphics(
-                gpu,
-                &GraphicsDesc {
-                    name: "geometry-mips",
-                    fragment_shader: shader,
-                    sets: &[setup.frame, set],
-                    color_formats: &color_formats,
-                    ..Default::default()
-                },
-            )
+        let desc = |shader| GraphicsDesc {
+            name: "geometry-mips",
+            fragment_shader: shader,
+            color_formats: &color_formats,
+            ..Default::default()
         };
-        let level_one_set = DescriptorSet::new(
+        let level_one = PassPipeline::graphics(
             gpu,
-            "geometry-mips",
+            setup.frame,
             &[
                 Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                 Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
             ],
+            desc("geometry_level_one.frag"),
         )?;
         // Level l (2..=L) reads mip l - 2, level l - 1 (mip m is level m + 1).
         let above_sets = (2..=m.levels as usize)
@@ -65,15 +59,22 @@ impl GeometryMipsPass {
                 DescriptorSet::new(gpu, "geometry-mips", &bindings)
             })
             .collect::<Result<Vec<_>>>()?;
+        // One pipeline for all of them (their sets' layouts are alike).
         let above = match above_sets.first() {
-            Some(first) => Some((pipeline("geometry_mips.frag", first)?, above_sets)),
+            Some(first) => {
+                let sets = &[setup.frame, first];
+                let pipeline = Pipeline::graphics(
+                    gpu,
+                    &GraphicsDesc {
+                        sets,
+                        ..desc("geometry_mips.frag")
+                    },
+                )?;
+                Some((pipeline, above_sets))
+            }
             None => None,
         };
-        Ok(Self {
-            level_one: pipeline("geometry_level_one.frag", &level_one_set)?,
-            level_one_set,
-            above,
-        })
+        Ok(Self { level_one, above })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
@@ -116,17 +117,16 @@ impl GeometryMipsPass {
                         ..Attachments::simple(&views, None, m.level_extent(level))
                     },
                 );
-                let (pipeline, set) = match (level, &self.above) {
-                    (1, _) => (&self.level_one, &self.level_one_set),
-                    (_, Some((above, sets))) => (above, &sets[level as usize - 2]),
+                match (level, &self.above) {
+                    (1, _) => self.level_one.bind(gpu, cmd, ctx.frame_set),
+                    (_, Some((above, sets))) => above.bind(
+                        gpu,
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        &[ctx.frame_set, sets[level as usize - 2].set],
+                    ),
                     (_, None) => unreachable!("levels above 1 have their pipeline"),
-                };
-                pipeline.bind(
-                    gpu,
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    &[ctx.frame_set, set.set],
-                );
+                }
                 unsafe {
                     gpu.device.cmd_draw(cmd, 3, 1, 0, 0);
                     gpu.device.cmd_end_rendering(cmd);
