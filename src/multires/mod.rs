@@ -33,7 +33,7 @@ pub struct MultiresBuffer {
     /// (l >= 1): its value and its relation to its neighbours, in layer l % 2
     /// (`upsample.comp`, `store_tap`). Two layers of level 1's size.
     pub upsample_taps: Image,
-    /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.comp`).
+    /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.glsl`).
     pub illumination: Image,
     /// Light patches each eye-space patch evaluated (a count in R32_SFLOAT, so
     /// splats can add it up; layered like the illumination buffer).

@@ -138,7 +138,11 @@ impl UpsamplePass {
             begin_rendering(
                 gpu,
                 cmd,
-                &Attachments::simple(&[t.indirect.view], None, t.indirect.extent),
+                &Attachments {
+                    // Every pixel is written: nothing to clear.
+                    clear_colors: false,
+                    ..Attachments::simple(&[t.indirect.view], None, t.indirect.extent)
+                },
             );
             self.level_zero.bind(gpu, cmd, ctx.frame_set);
             unsafe {
