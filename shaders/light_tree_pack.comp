@@ -9,7 +9,9 @@
 //
 // Order: depth-major from the root. Depth d (2^d x 2^d patches, RSM mip
 // top - d) starts at node (4^d - 1) / 3, row-major inside: node (x, y) of depth
-// d is (4^d - 1) / 3 + y 2^d + x. One invocation per node, laid out R wide.
+// d is (4^d - 1) / 3 + y 2^d + x. Only depths down to the max depth D are
+// packed (nodes there never split, so none deeper is read). One invocation per
+// node, laid out 2^D wide.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "light_types.glsl"
@@ -20,17 +22,17 @@ layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip c
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
 layout(set = 1, binding = 3, std430) writeonly buffer LightTree {
-    uint count;  // nodes in the tree, (4 R^2 - 1) / 3
+    uint count;  // nodes packed, (4^(D+1) - 1) / 3
     uint pad0, pad1, pad2;
     LightPatch nodes[];
 };
 
 void main() {
     int top = run.light_levels.w;  // mip of the root
-    int r = 1 << top;
-    int i = int(gl_GlobalInvocationID.y) * r + int(gl_GlobalInvocationID.x);
-    int total = (4 * r * r - 1) / 3;
-    if (gl_GlobalInvocationID.x >= uint(r) || i >= total) return;
+    int w = 1 << run.light_levels.y;  // 2^D patches per side at the max depth
+    int i = int(gl_GlobalInvocationID.y) * w + int(gl_GlobalInvocationID.x);
+    int total = (4 * w * w - 1) / 3;
+    if (gl_GlobalInvocationID.x >= uint(w) || i >= total) return;
     if (i == 0) count = uint(total);
     int node = i;
     int d = 0;

@@ -283,7 +283,8 @@ fn stats_and_vpl_count_view_from_the_cli() {
 /// log2 R - d (position and area, normal and state, flux), and in flux.a its
 /// squared reach (`hisr_reach`): for the spot light 4^k T |p - light|^2, k its
 /// levels above the finest, divided by HISR_INVALID_TAU_SCALE for invalid
-/// patches; -1 at the max depth and for empty nodes.
+/// patches; -1 at the max depth and for empty nodes. Depths below the max
+/// depth are never read, and not packed.
 #[test]
 fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
     let gpu = gpu();
@@ -305,10 +306,12 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
     assert!(max_depth < top, "some depths should never split");
     let t = isr::methods::hisr::subdivision_threshold(s.light_tree.tau, rsm) as f64;
     let light = scene.lights[0].position.as_dvec3();
-    assert_eq!(packed.len(), ((4 * rsm * rsm - 1) / 3) as usize);
+    let side = 1usize << max_depth;
+    assert_eq!(packed.len(), (4 * side * side - 1) / 3);
+    assert_eq!(packed.len() as u64, isr::methods::hisr::packed_nodes(&s));
     let mut index = 0;
     let (mut lit, mut invalid) = (0, 0);
-    for d in 0..=top {
+    for d in 0..=max_depth {
         let side = 1usize << d;
         let [pos, nrm, flux] = &m.rsm_tree[top - d];
         for i in 0..side * side {

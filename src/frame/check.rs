@@ -152,7 +152,8 @@ pub fn memory_estimate(s: &RenderSettings) -> u64 {
             0
         }
         + if s.method == Method::Hisr {
-            crate::methods::hisr::cut_bytes(s)
+            let node = std::mem::size_of::<crate::gpu_types::LightPatch>() as u64;
+            crate::methods::hisr::packed_nodes(s) * node + crate::methods::hisr::cut_bytes(s)
         } else {
             0
         }
