@@ -130,7 +130,7 @@ struct RenderArgs {
     start_level: u32,
     /// HISR subdivides at most down to 2^d x 2^d patches (at most log2 of
     /// --rsm; default 6, or log2 of --rsm if smaller); patches spanning a
-    /// discontinuity are always split down to it.
+    /// discontinuity are held to 1/100 of tau.
     #[arg(long)]
     max_depth: Option<u32>,
     /// HISR's error threshold, as a fraction of the light's peak intensity: a
