@@ -120,6 +120,12 @@ pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
                 ),
             }
         }
+        let (front, detail) = hisr_front(rows, s);
+        push(
+            "least speedup of hisr over any other method's point at equal or lower error".into(),
+            front,
+            detail,
+        );
         let hisr = rows
             .iter()
             .find(|r| r.scene == s && r.method == "hisr" && r.is_default);
@@ -137,6 +143,40 @@ pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
         }
     }
     out
+}
+
+/// Whether HISR's curve lies below every other method's (the goal on
+/// the open scene): over every point of every other method in `scene`, the
+/// speedup of the fastest HISR point at equal or lower error; the least of
+/// them, the point it was, and how many points lie below every HISR error
+/// (where HISR has no point to compare).
+fn hisr_front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
+    let mut least: Option<(f64, &Row, &Row)> = None;
+    let (mut reached, mut unreached) = (0, 0);
+    let others = rows.iter().filter(|r| {
+        r.scene == scene
+            && r.indirect_ms.is_some()
+            && (REGULAR.contains(&r.method.as_str()) || r.method == "isr")
+    });
+    for b in others {
+        let Some(h) = fastest_at_most(rows, scene, "hisr", b.rel_rmse_indirect) else {
+            unreached += 1;
+            continue;
+        };
+        reached += 1;
+        let v = ms(b) / ms(h);
+        if least.is_none_or(|(l, ..)| v < l) {
+            least = Some((v, h, b));
+        }
+    }
+    let below = format!("{unreached} of {} points below every hisr error", reached + unreached);
+    match least {
+        Some((v, h, b)) => (
+            Some(v),
+            format!("{} against {}; {below}", describe(h), describe(b)),
+        ),
+        None => (None, below),
+    }
 }
 
 fn fmt_value(v: Option<f64>) -> String {
@@ -297,5 +337,25 @@ mod tests {
             get("flicker of hisr (default) / multires-gather 4096"),
             Some(1.0)
         );
+        // Every other point: multires-gather 256 (80 ms, 0.2) against hisr
+        // 10 ms is the least, 8x; none lies below hisr's best error 0.07.
+        let front = r
+            .iter()
+            .find(|x| x.measure.starts_with("least speedup of hisr"))
+            .unwrap();
+        assert_eq!(front.value, Some(8.0));
+        assert!(front.detail.ends_with("0 of 3 points below every hisr error"));
+        // A cheap coarse point HISR cannot beat, and one below its errors.
+        let mut more = rows.clone();
+        more.push(row("rsm-splat-restricted", Some(64), 4.0, 0.5, 0.1));
+        more.push(row("rsm-gather", Some(4096), 900.0, 0.01, 0.1));
+        let r = ratios(&more);
+        let front = r
+            .iter()
+            .find(|x| x.measure.starts_with("least speedup of hisr"))
+            .unwrap();
+        // 0.3 <= 0.5 at 5 ms: 4 / 5.
+        assert_eq!(front.value, Some(0.8));
+        assert!(front.detail.ends_with("1 of 5 points below every hisr error"));
     }
 }

@@ -113,10 +113,14 @@ pub fn sweep(method: Method, rsm: u32, quick: bool) -> Vec<Config> {
                 .collect()
         }
         Method::Hisr => {
+            // Large taus trace the cheap end of HISR's front (at tau 0.97
+            // a valid patch splits only for receivers very near it, while
+            // invalid ones are still held to tau / 100); smaller max depths
+            // at the two largest taus go cheaper still.
             let taus: &[f32] = if quick {
                 &[0.2, 0.05]
             } else {
-                &[0.5, 0.2, 0.05, 0.01]
+                &[0.97, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
             };
             let mut v: Vec<Config> = taus
                 .iter()
@@ -127,12 +131,15 @@ pub fn sweep(method: Method, rsm: u32, quick: bool) -> Vec<Config> {
                 .collect();
             if !quick {
                 let deepest = 6.min(rsm.ilog2());
-                for d in [deepest.saturating_sub(2), deepest.saturating_sub(1)] {
-                    if d >= RenderSettings::DEFAULT.light_tree.start_level {
-                        v.push(Config {
-                            max_depth: Some(d),
-                            ..c()
-                        });
+                for t in [0.97, 0.9] {
+                    for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
+                        if d >= RenderSettings::DEFAULT.light_tree.start_level {
+                            v.push(Config {
+                                tau: Some(t),
+                                max_depth: Some(d),
+                                ..c()
+                            });
+                        }
                     }
                 }
                 for t in [0.05, 0.3] {
