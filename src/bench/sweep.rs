@@ -120,7 +120,7 @@ pub fn sweep(method: Method, rsm: u32, quick: bool) -> Vec<Config> {
             let taus: &[f32] = if quick {
                 &[0.2, 0.05]
             } else {
-                &[0.97, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
+                &[0.97, 0.94, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
             };
             let mut v: Vec<Config> = taus
                 .iter()
