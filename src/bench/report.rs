@@ -169,7 +169,10 @@ fn hisr_front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
             least = Some((v, h, b));
         }
     }
-    let below = format!("{unreached} of {} points below every hisr error", reached + unreached);
+    let below = format!(
+        "{unreached} of {} points below every hisr error",
+        reached + unreached
+    );
     match least {
         Some((v, h, b)) => (
             Some(v),
@@ -344,7 +347,9 @@ mod tests {
             .find(|x| x.measure.starts_with("least speedup of hisr"))
             .unwrap();
         assert_eq!(front.value, Some(8.0));
-        assert!(front.detail.ends_with("0 of 3 points below every hisr error"));
+        assert!(front
+            .detail
+            .ends_with("0 of 3 points below every hisr error"));
         // A cheap coarse point HISR cannot beat, and one below its errors.
         let mut more = rows.clone();
         more.push(row("rsm-splat-restricted", Some(64), 4.0, 0.5, 0.1));
@@ -356,6 +361,8 @@ mod tests {
             .unwrap();
         // 0.3 <= 0.5 at 5 ms: 4 / 5.
         assert_eq!(front.value, Some(0.8));
-        assert!(front.detail.ends_with("1 of 5 points below every hisr error"));
+        assert!(front
+            .detail
+            .ends_with("1 of 5 points below every hisr error"));
     }
 }
