@@ -15,8 +15,7 @@ use serde_json::json;
 
 fn gather_ms(stats: &isr::renderer::FrameStats, name: &str) -> f64 {
     let times: Vec<f64> = stats
-        .frames
-        .iter()
+        .timed()
         .filter_map(|f| f.iter().find(|p| p.name == name)?.gpu_ms)
         .collect();
     isr::report::median(&times).unwrap_or(f64::NAN)
@@ -42,7 +41,7 @@ fn main() -> anyhow::Result<()> {
         r.render_frames(1, |_| {})?;
         let frames = if stencil { 10 } else { 3 };
         let stats = r.render_frames(frames, |_| {})?;
-        let last = stats.frames.last().unwrap();
+        let last = stats.counts().unwrap();
         let gather = last.iter().find(|p| p.name == "gather").unwrap();
         let m = r.readback_multires()?.unwrap();
         let area = r.multires().unwrap().total_area();

@@ -12,10 +12,12 @@ pub struct PassReport {
     pub indirect: bool,
     pub gpu_ms_median: Option<f64>,
     pub gpu_ms_min: Option<f64>,
-    /// Pipeline statistics (last frame). On lavapipe this counts rejected blocks too.
+    /// Pipeline statistics (the counting frame, the last). On lavapipe this
+    /// counts rejected blocks too.
     pub fragment_invocations: Option<u64>,
     pub compute_invocations: Option<u64>,
-    /// Occlusion query (last frame): fragments that passed depth and stencil tests.
+    /// Occlusion query (the counting frame): fragments that passed depth and
+    /// stencil tests.
     pub samples_passed: Option<u64>,
 }
 
@@ -73,16 +75,12 @@ pub struct RunInfo<'a> {
 }
 
 pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
-    let last = stats.frames.last().cloned().unwrap_or_default();
-    let passes = last
+    let counts = stats.counts().unwrap_or_default();
+    let passes = counts
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let times: Vec<f64> = stats
-                .frames
-                .iter()
-                .filter_map(|f| f.get(i)?.gpu_ms)
-                .collect();
+            let times: Vec<f64> = stats.timed().filter_map(|f| f.get(i)?.gpu_ms).collect();
             PassReport {
                 name: p.name.to_string(),
                 indirect: p.kind.indirect,

@@ -19,7 +19,11 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
     };
     let out = render(&gpu, &cornell_box(), &settings, 4);
     assert_eq!(out.stats.frames.len(), 4);
-    for (frame, wall) in out.stats.frames.iter().zip(&out.stats.wall_ms) {
+    // The last frame counts; the three before it only time.
+    assert_eq!(out.stats.counted, [false, false, false, true]);
+    assert_eq!(out.stats.timed().count(), 3);
+    let frames = out.stats.frames.iter().zip(&out.stats.counted);
+    for ((frame, &counted), wall) in frames.zip(&out.stats.wall_ms) {
         let names: Vec<&str> = frame.iter().map(|p| p.name).collect();
         assert_eq!(names, PASSES);
         let mut sum = 0.0;
@@ -28,14 +32,16 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
             // Every pass does work at 128x128; a zero would mean a missing timestamp.
             assert!(ms > 0.0, "pass {} took {ms} ms", p.name);
             sum += ms;
-            assert!(
+            assert_eq!(
                 p.fragment_invocations.is_some_and(|n| n > 0),
-                "pass {} has no fragment count",
+                counted,
+                "pass {}: a fragment count only in the counting frame",
                 p.name
             );
-            assert!(
+            assert_eq!(
                 p.samples_passed.is_some_and(|n| n > 0),
-                "pass {} has no samples passed",
+                counted,
+                "pass {}: samples passed only in the counting frame",
                 p.name
             );
         }
@@ -45,7 +51,7 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
         );
     }
     // Full-screen passes shade every pixel exactly once.
-    let last = out.stats.frames.last().unwrap();
+    let last = out.stats.counts().unwrap();
     for p in last
         .iter()
         .filter(|p| ["direct", "composite", "tonemap"].contains(&p.name))

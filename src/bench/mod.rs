@@ -351,8 +351,8 @@ fn run_scene(
                 plan.frames
             ));
             r.update(&scene.state_at(frame_time(spec, k)))?;
-            let stats = r.render_frames(1, |_| {})?;
-            ref_stats.frames.extend(stats.frames);
+            let last = k + 1 == plan.frames;
+            ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
             let out = r.readback()?;
             if k == plan.frames / 2 {
                 crate::output::write_png(
@@ -412,8 +412,9 @@ fn run_scene(
             ));
             r.update(&scene.state_at(frame_time(spec, k)))?;
             let n = if k == 0 { plan.timing_frames } else { 1 };
-            let s = r.render_frames(n, |_| {})?;
-            stats.frames.extend(s.frames);
+            // Every frame times but the run's last, which counts (`Profiler`).
+            let last = k + 1 == plan.frames;
+            stats.extend(r.render_frames_counting(n, last, |_| {})?);
             let out = r.readback()?;
             let reference = &refs[k as usize];
             e_ind += metrics::relative_rmse(&out.indirect, &reference.indirect, &reference.mask);
@@ -524,8 +525,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         stats,
     );
     let indirect_min = stats
-        .frames
-        .iter()
+        .timed()
         .filter_map(|f| {
             f.iter()
                 .filter(|p| p.kind.indirect)
@@ -533,8 +533,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
                 .try_fold(0.0, |a, ms| Some(a + ms?))
         })
         .reduce(f64::min);
-    let last = stats.frames.last();
-    let fragments = last.map(|f| {
+    let fragments = stats.counts().map(|f| {
         f.iter()
             .filter(|p| p.kind.indirect)
             .filter_map(|p| p.fragment_invocations)

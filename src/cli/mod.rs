@@ -73,7 +73,8 @@ struct RenderArgs {
     /// Reflective shadow map resolution R (R x R, a power of two).
     #[arg(long, default_value_t = D.rsm_resolution)]
     rsm: u32,
-    /// Frames to render; timings are medians over them.
+    /// Frames to render; timings are medians over them (over all but the last,
+    /// which alone counts fragments and invocations, when there are several).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
     /// Multi-layer OpenEXR output (linear).

@@ -43,7 +43,8 @@ impl<'g> Renderer<'g> {
             let uniforms = self.view_uniforms(v);
             self.slots[slot].frames[v].write(&uniforms, &transforms);
         }
-        self.record(slot, Some(&mut *extension))?;
+        // The viewer shows times only: no frame counts.
+        self.record(slot, Some(&mut *extension), false)?;
         let submissions = self.submissions();
         let s = &mut self.slots[slot];
         let cmds = s.cmds[..submissions].to_vec();

@@ -41,7 +41,12 @@ const MAX_PASSES: u32 = 32;
 /// GPU numbers of every frame rendered, and the CPU-measured wall time of each.
 #[derive(Clone, Debug, Default)]
 pub struct FrameStats {
+    /// Every frame's passes, in the order the frames finished.
     pub frames: Vec<Vec<PassSample>>,
+    /// Per frame: whether it held the statistics and occlusion queries (a
+    /// counting frame, `Profiler`), whose times are left out when a run has
+    /// frames that only timed.
+    pub counted: Vec<bool>,
     /// Per frame, from its first submission to the moment its fence was seen
     /// signalled: at least its GPU time, more when it waited behind the frame
     /// before it.
@@ -65,9 +70,40 @@ impl FrameStats {
         self.gpu_ms_sums(indirect_only).into_iter().reduce(f64::min)
     }
 
-    fn gpu_ms_sums(&self, indirect_only: bool) -> Vec<f64> {
+    /// Appends the frames of a later call (the run goes on).
+    pub fn extend(&mut self, later: FrameStats) {
+        self.frames.extend(later.frames);
+        self.counted.extend(later.counted);
+        self.wall_ms.extend(later.wall_ms);
+        if later.patches_per_level.is_some() {
+            self.patches_per_level = later.patches_per_level;
+        }
+    }
+
+    /// The frames whose times count: those that only timed, or every frame
+    /// when all of them counted (a one-frame run).
+    pub fn timed(&self) -> impl Iterator<Item = &Vec<PassSample>> + '_ {
+        let any_timing = self.counted.iter().any(|&c| !c);
         self.frames
             .iter()
+            .zip(&self.counted)
+            .filter(move |&(_, &c)| !(any_timing && c))
+            .map(|(f, _)| f)
+    }
+
+    /// The passes of the last counting frame: their fragment and invocation
+    /// counts (the times of every pass are in [`Self::timed`]).
+    pub fn counts(&self) -> Option<&[PassSample]> {
+        self.frames
+            .iter()
+            .zip(&self.counted)
+            .rev()
+            .find(|&(_, &c)| c)
+            .map(|(f, _)| f.as_slice())
+    }
+
+    fn gpu_ms_sums(&self, indirect_only: bool) -> Vec<f64> {
+        self.timed()
             .filter_map(|f| {
                 f.iter()
                     .filter(|p| !indirect_only || p.kind.indirect)
@@ -352,7 +388,14 @@ impl<'g> Renderer<'g> {
     /// RSM, direct light, light tree and method passes (summed by
     /// `light-sum` when there are several), then the composite, tonemap and
     /// what `extension` adds (the viewer's presentation).
-    fn record(&mut self, slot: usize, extension: Option<&mut dyn FrameExtension>) -> Result<()> {
+    /// Records the frame of `slot`; a `counting` frame holds the statistics and
+    /// occlusion queries (`Profiler`).
+    fn record(
+        &mut self,
+        slot: usize,
+        extension: Option<&mut dyn FrameExtension>,
+        counting: bool,
+    ) -> Result<()> {
         let gpu = self.gpu;
         let chunks = self.method.submissions();
         let active = self.active_views();
@@ -394,7 +437,7 @@ impl<'g> Renderer<'g> {
         };
         let p = &mut slot.profiler;
         begin(cmds[0])?;
-        p.begin_frame(gpu, cmds[0]);
+        p.begin_frame(gpu, cmds[0], counting);
         let mut c = 0;
         for (i, &v) in active.iter().enumerate() {
             match (self.views[v].face, &self.rsm_cube) {
@@ -461,15 +504,29 @@ impl<'g> Renderer<'g> {
         gpu.wait(s.fence)?;
         stats.wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
         stats.frames.push(s.profiler.read(gpu)?);
+        stats.counted.push(s.profiler.counting());
         Ok(())
     }
 
     /// Renders `n` frames of the current frame state, up to `FRAMES_IN_FLIGHT`
-    /// at once, and returns every frame's per-pass numbers. `progress` is
-    /// called as frames (and the submissions of multi-submission frames) finish.
+    /// at once, and returns every frame's per-pass numbers: the last frame
+    /// counts fragments and invocations, the others only time (`Profiler`).
+    /// `progress` is called as frames (and the submissions of multi-submission
+    /// frames) finish.
     pub fn render_frames(
         &mut self,
         n: u32,
+        progress: impl FnMut(FrameProgress),
+    ) -> Result<FrameStats> {
+        self.render_frames_counting(n, true, progress)
+    }
+
+    /// [`Self::render_frames`], where the last frame counts only when
+    /// `count_last` (a run of several calls counts once, in its last call).
+    pub fn render_frames_counting(
+        &mut self,
+        n: u32,
+        count_last: bool,
         mut progress: impl FnMut(FrameProgress),
     ) -> Result<FrameStats> {
         let gpu = self.gpu;
@@ -482,7 +539,7 @@ impl<'g> Renderer<'g> {
             submission,
             submissions,
         };
-        for _ in 0..n {
+        for i in 0..n {
             let slot = self.next_slot;
             self.next_slot = (slot + 1) % self.slots.len();
             // The slot's previous frame must finish before its buffers change.
@@ -496,7 +553,8 @@ impl<'g> Renderer<'g> {
                 let uniforms = self.view_uniforms(v);
                 self.slots[slot].frames[v].write(&uniforms, &transforms);
             }
-            self.record(slot, None)?;
+            // The last frame counts; the others only time (`Profiler`).
+            self.record(slot, None, count_last && i + 1 == n)?;
             let s = &mut self.slots[slot];
             let submitted = Instant::now();
             let cmds = s.cmds[..submissions as usize].to_vec();
