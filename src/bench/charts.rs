@@ -110,7 +110,24 @@ fn short(v: f64) -> String {
     format!("{v:.digits$}")
 }
 
-/// Panels of (x, y) curves, one per method over its sweep, log-log.
+/// The points of `sorted` (by x) that no earlier point matches or beats in y:
+/// a method's front, its least y at each x. A dense sweep's points joined in
+/// order zigzag; the line follows the front and every point gets a dot.
+fn front(sorted: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut best = f64::INFINITY;
+    sorted
+        .iter()
+        .filter(|&&(_, y)| {
+            let keep = y < best;
+            best = best.min(y);
+            keep
+        })
+        .copied()
+        .collect()
+}
+
+/// Panels of (x, y) curves, one per method over its sweep, log-log: a line
+/// along the method's front (`front`), a dot per point.
 fn curves<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Row],
@@ -171,7 +188,7 @@ where
                 .collect();
             line.sort_by(|a, b| a.0.total_cmp(&b.0));
             chart
-                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
+                .draw_series(LineSeries::new(front(&line), color.stroke_width(2)))
                 .map_err(|e| anyhow!("{e}"))?
                 .label(m)
                 .legend(move |(x, y)| {
@@ -412,4 +429,16 @@ pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) ->
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
     crate::output::write_png(&dir.join("gallery.png"), w, h, &rgba)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::front;
+
+    #[test]
+    fn the_front_keeps_only_points_lower_than_every_faster_one() {
+        let sorted = [(1.0, 0.5), (2.0, 0.6), (3.0, 0.4), (4.0, 0.4), (5.0, 0.1)];
+        assert_eq!(front(&sorted), [(1.0, 0.5), (3.0, 0.4), (5.0, 0.1)]);
+        assert!(front(&[]).is_empty());
+    }
 }
