@@ -152,7 +152,7 @@ pub fn sweep(method: Method, rsm: u32, quick: bool) -> Vec<Config> {
                 // RSM 128), where the default depth stops near the error of
                 // 4^6 = 4096 VPLs.
                 if rsm.ilog2() > deepest {
-                    for t in [0.2, 0.05, 0.01] {
+                    for t in [0.2, 0.1, 0.05, 0.01] {
                         v.push(Config {
                             tau: Some(t),
                             max_depth: Some(deepest + 1),
