@@ -75,7 +75,12 @@ pub struct RunInfo<'a> {
 }
 
 pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
-    let counts = stats.counts().unwrap_or_default();
+    // The pass list and counts of the counting frame (a run without one, such
+    // as a benchmark's timing-only frames, lists the last frame's passes).
+    let counts = stats
+        .counts()
+        .or(stats.frames.last().map(|f| f.as_slice()))
+        .unwrap_or_default();
     let passes = counts
         .iter()
         .enumerate()
@@ -177,7 +182,61 @@ pub fn table(r: &TimingReport) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::median;
+    use super::{build, median, RunInfo};
+    use crate::renderer::FrameStats;
+    use crate::vk::profiler::{PassKind, PassSample};
+
+    /// One pass of `ms`, with a count when the frame counted.
+    fn frame(ms: f64, counted: bool) -> Vec<PassSample> {
+        vec![PassSample {
+            name: "gather",
+            kind: PassKind {
+                graphics: true,
+                indirect: true,
+            },
+            gpu_ms: Some(ms),
+            fragment_invocations: counted.then_some(7),
+            compute_invocations: counted.then_some(0),
+            samples_passed: counted.then_some(5),
+        }]
+    }
+
+    fn stats(frames: &[(f64, bool)]) -> FrameStats {
+        FrameStats {
+            frames: frames.iter().map(|&(ms, c)| frame(ms, c)).collect(),
+            counted: frames.iter().map(|&(_, c)| c).collect(),
+            wall_ms: vec![0.0; frames.len()],
+            ..Default::default()
+        }
+    }
+
+    const INFO: RunInfo = RunInfo {
+        device: "",
+        driver: "",
+        scene: "",
+        width: 1,
+        height: 1,
+        rsm: 1,
+        method: "",
+    };
+
+    #[test]
+    fn times_leave_out_the_counting_frame_unless_every_frame_counted() {
+        // The counting frame's 9 ms (its queries' cost) stays out of the times.
+        let s = stats(&[(1.0, false), (2.0, false), (9.0, true)]);
+        let r = build(&INFO, &s);
+        assert_eq!(r.passes[0].gpu_ms_median, Some(1.5));
+        assert_eq!(r.passes[0].gpu_ms_min, Some(1.0));
+        assert_eq!(r.passes[0].samples_passed, Some(5));
+        assert_eq!(s.gpu_ms_median(true), Some(1.5));
+        // A one-frame run counts and times in the same frame.
+        let one = stats(&[(9.0, true)]);
+        assert_eq!(build(&INFO, &one).passes[0].gpu_ms_median, Some(9.0));
+        // Timing-only frames still list their passes, without counts.
+        let timing = build(&INFO, &stats(&[(1.0, false), (3.0, false)]));
+        assert_eq!(timing.passes[0].gpu_ms_median, Some(2.0));
+        assert_eq!(timing.passes[0].samples_passed, None);
+    }
 
     #[test]
     fn median_of_odd_even_and_empty() {
