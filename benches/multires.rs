@@ -101,7 +101,7 @@ fn main() -> anyhow::Result<()> {
         report.insert(
             format!("stencil_{}", if stencil { "on" } else { "off" }),
             json!({"gather_ms_median": ms, "samples_passed": gather.samples_passed, "fragment_invocations": gather.fragment_invocations,
-                   "passes": last.iter().map(|p| json!({"name": p.name, "gpu_ms": p.gpu_ms})).collect::<Vec<_>>()}),
+                   "passes": last.iter().map(|p| json!({"name": p.name, "gpu_ms_median": gather_ms(&stats, p.name)})).collect::<Vec<_>>()}),
         );
         report.insert("total_area".into(), json!(area));
         results.push(ms);

@@ -109,7 +109,7 @@ pub fn build(info: &RunInfo, stats: &FrameStats) -> TimingReport {
         passes,
         total_gpu_ms_median: stats.gpu_ms_median(false),
         indirect_gpu_ms_median: stats.gpu_ms_median(true),
-        wall_ms_median: median(&stats.wall_ms).unwrap_or(0.0),
+        wall_ms_median: median(&stats.timed_wall_ms()).unwrap_or(0.0),
         patches_per_level: stats.patches_per_level.clone(),
         light_patches: None,
         time: None,
@@ -205,7 +205,7 @@ mod tests {
         FrameStats {
             frames: frames.iter().map(|&(ms, c)| frame(ms, c)).collect(),
             counted: frames.iter().map(|&(_, c)| c).collect(),
-            wall_ms: vec![0.0; frames.len()],
+            wall_ms: frames.iter().map(|&(ms, _)| ms + 0.5).collect(),
             ..Default::default()
         }
     }
@@ -229,6 +229,7 @@ mod tests {
         assert_eq!(r.passes[0].gpu_ms_min, Some(1.0));
         assert_eq!(r.passes[0].samples_passed, Some(5));
         assert_eq!(s.gpu_ms_median(true), Some(1.5));
+        assert_eq!(r.wall_ms_median, 2.0);
         // A one-frame run counts and times in the same frame.
         let one = stats(&[(9.0, true)]);
         assert_eq!(build(&INFO, &one).passes[0].gpu_ms_median, Some(9.0));

@@ -83,12 +83,29 @@ impl FrameStats {
     /// The frames whose times count: those that only timed, or every frame
     /// when all of them counted (a one-frame run).
     pub fn timed(&self) -> impl Iterator<Item = &Vec<PassSample>> + '_ {
-        let any_timing = self.counted.iter().any(|&c| !c);
         self.frames
             .iter()
-            .zip(&self.counted)
-            .filter(move |&(_, &c)| !(any_timing && c))
+            .zip(self.timed_mask())
+            .filter(|&(_, t)| t)
             .map(|(f, _)| f)
+    }
+
+    /// The wall times of the frames [`Self::timed`] yields.
+    pub fn timed_wall_ms(&self) -> Vec<f64> {
+        self.wall_ms
+            .iter()
+            .zip(self.timed_mask())
+            .filter(|&(_, t)| t)
+            .map(|(&ms, _)| ms)
+            .collect()
+    }
+
+    /// Per frame, whether its times count (`frames`, `counted` and
+    /// `wall_ms` run in step).
+    fn timed_mask(&self) -> impl Iterator<Item = bool> + '_ {
+        debug_assert_eq!(self.frames.len(), self.counted.len());
+        let any_timing = self.counted.iter().any(|&c| !c);
+        self.counted.iter().map(move |&c| !(any_timing && c))
     }
 
     /// The passes of the last counting frame: their fragment and invocation

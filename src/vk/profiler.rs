@@ -1,5 +1,6 @@
-//! Named GPU timing scopes: a timestamp, a pipeline-statistics query and an
-//! occlusion query around every pass, plus a debug label.
+//! Named GPU timing scopes: a timestamp around every pass, plus a
+//! pipeline-statistics query and an occlusion query in counting frames (see
+//! below), and a debug label.
 //!
 //! Timing model. Lavapipe (Mesa 22.3) bins the commands of one command buffer,
 //! so a timestamp written just *before* a pass reads close to that pass's *end*.
