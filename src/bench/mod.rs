@@ -524,15 +524,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         },
         stats,
     );
-    let indirect_min = stats
-        .timed()
-        .filter_map(|f| {
-            f.iter()
-                .filter(|p| p.kind.indirect)
-                .map(|p| p.gpu_ms)
-                .try_fold(0.0, |a, ms| Some(a + ms?))
-        })
-        .reduce(f64::min);
+    let indirect_min = stats.gpu_ms_min(true);
     let fragments = stats.counts().map(|f| {
         f.iter()
             .filter(|p| p.kind.indirect)
