@@ -1,7 +1,9 @@
 #version 460
 // Stenciled refinement (docs/algorithm.md section 3, step 4), one pass over every
 // layer: a fragment survives, and the stencil op writes 1, iff its texel is a
-// patch. Surviving fragments are also counted per level for --stats.
+// patch. In a frame that counts (src/vk/profiler.rs), surviving fragments are
+// also counted per level for --stats; the other frames skip the atomics, which
+// cost CPU drivers a fifth of the pass.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 
@@ -14,8 +16,10 @@ layout(set = 1, binding = 3) uniform sampler2D gbuffer_normal;
 #define GEO_FLAGS
 #include "geo_levels.glsl"
 
+layout(constant_id = 0) const bool COUNT = true;
+
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     if (!is_patch(level, run.hierarchy.x, p)) discard;
-    atomicAdd(patches_per_level[level], 1u);
+    if (COUNT) atomicAdd(patches_per_level[level], 1u);
 }

@@ -2,6 +2,7 @@
 mod common;
 
 use common::*;
+use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};
 
@@ -58,6 +59,37 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
     {
         assert_eq!(p.samples_passed, Some(128 * 128), "pass {}", p.name);
     }
+}
+
+#[test]
+fn patches_are_counted_only_in_a_counting_frame_and_match_the_gathered_texels() {
+    let gpu = gpu();
+    let settings = RenderSettings {
+        width: 128,
+        height: 128,
+        rsm_resolution: 128,
+        method: Method::MultiresGather,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &cornell_box(), &settings).expect("renderer setup");
+    // Frames that only time skip the stencil pass's atomics: no counts.
+    let timed = r.render_frames_counting(3, false, |_| {}).unwrap();
+    assert_eq!(timed.counted, [false; 3]);
+    assert_eq!(timed.patches_per_level, None);
+    let counted = r.render_frames(1, |_| {}).unwrap();
+    let patches = counted.patches_per_level.clone();
+    let patches = patches.expect("a counting frame counts patches");
+    // The stencil pass counts the texels the gather's stencil test passes.
+    let gather = counted
+        .counts()
+        .unwrap()
+        .iter()
+        .find(|p| p.name == "gather");
+    let passed = gather.and_then(|p| p.samples_passed).unwrap();
+    assert!(passed > 0);
+    assert_eq!(patches.iter().map(|&n| n as u64).sum::<u64>(), passed);
+    drop(r);
+    assert_validation_clean(&gpu);
 }
 
 #[test]

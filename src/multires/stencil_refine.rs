@@ -2,7 +2,8 @@
 //! section 3, step 4). One instanced draw covers every layer of the stencil
 //! (`shaders/layered.vert` picks the layer); `shaders/stencil_refine.frag`
 //! discards texels that are not patches and the stencil op writes 1 for the
-//! rest. Reads `geo_flags`; writes the layered stencil and the patch counts.
+//! rest. Reads `geo_flags`; writes the layered stencil and, in a frame that
+//! counts (`Profiler::counting`), the patch counts.
 
 use super::MultiresBuffer;
 use crate::frame::{FrameContext, Setup};
@@ -13,7 +14,13 @@ use crate::vk::profiler::Profiler;
 use anyhow::Result;
 use ash::vk;
 
-pub struct StencilRefinePass(PassPipeline);
+/// The same draw with and without the per-level patch counts (specialisation
+/// constant 0 of `stencil_refine.frag`): their atomics are statistics, paid
+/// only in the frame that counts, like the profiler's queries.
+pub struct StencilRefinePass {
+    counting: PassPipeline,
+    timed: PassPipeline,
+}
 
 impl StencilRefinePass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
@@ -32,24 +39,32 @@ impl StencilRefinePass {
                 setup.samplers.nearest,
             ),
         ];
-        Ok(Self(PassPipeline::graphics(
-            setup.gpu,
-            setup.frame,
-            &bindings,
-            GraphicsDesc {
-                name: "stencil-refine",
-                vertex_shader: "layered.vert",
-                fragment_shader: "stencil_refine.frag",
-                stencil_format: m.stencil.format,
-                stencil: Some(StencilTest::WRITE_ONE),
-                ..Default::default()
-            },
-        )?))
+        let pipeline = |count: bool| {
+            PassPipeline::graphics(
+                setup.gpu,
+                setup.frame,
+                &bindings,
+                GraphicsDesc {
+                    name: "stencil-refine",
+                    vertex_shader: "layered.vert",
+                    fragment_shader: "stencil_refine.frag",
+                    stencil_format: m.stencil.format,
+                    stencil: Some(StencilTest::WRITE_ONE),
+                    specialization: &[(0, count as i32)],
+                    ..Default::default()
+                },
+            )
+        };
+        Ok(Self {
+            counting: pipeline(true)?,
+            timed: pipeline(false)?,
+        })
     }
 
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, m: &MultiresBuffer) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let d = &gpu.device;
+        let counting = profiler.counting();
         profiler.pass(gpu, cmd, "stencil-refine", INDIRECT_GRAPHICS, || unsafe {
             barrier::transition(
                 gpu,
@@ -58,25 +73,27 @@ impl StencilRefinePass {
                 Use::DISCARD_AFTER_STENCIL_READERS,
                 Use::STENCIL_ATTACHMENT,
             );
-            // The previous frame's atomics are done before the counts are reset
-            // (the host read them after that frame's fence).
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            );
-            d.cmd_fill_buffer(cmd, m.patch_counts.buffer, 0, vk::WHOLE_SIZE, 0);
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
+            if counting {
+                // The previous counting frame's atomics are done before the
+                // counts are reset (the host read them after its fence).
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                    vk::PipelineStageFlags2::ALL_TRANSFER,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                );
+                d.cmd_fill_buffer(cmd, m.patch_counts.buffer, 0, vk::WHOLE_SIZE, 0);
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_TRANSFER,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                );
+            }
             begin_rendering(
                 gpu,
                 cmd,
@@ -92,7 +109,11 @@ impl StencilRefinePass {
                     }),
                 },
             );
-            self.0.bind(gpu, cmd, ctx.frame_set);
+            match counting {
+                true => &self.counting,
+                false => &self.timed,
+            }
+            .bind(gpu, cmd, ctx.frame_set);
             d.cmd_draw(cmd, 6, m.levels + 1, 0, 0);
             d.cmd_end_rendering(cmd);
             barrier::transition(
@@ -102,14 +123,16 @@ impl StencilRefinePass {
                 Use::STENCIL_ATTACHMENT,
                 Use::STENCIL_READ_ONLY,
             );
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::HOST,
-                vk::AccessFlags2::HOST_READ,
-            );
+            if counting {
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                    vk::PipelineStageFlags2::HOST,
+                    vk::AccessFlags2::HOST_READ,
+                );
+            }
         });
     }
 }

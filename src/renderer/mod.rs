@@ -510,8 +510,11 @@ impl<'g> Renderer<'g> {
             progress(report(&stats, 0));
         }
         stats.elapsed_ms = started.elapsed().as_secs_f64() * 1e3;
-        // Every frame has finished: the counts are the last frame's.
-        stats.patches_per_level = self.method.multires().map(|m| m.patch_counts());
+        // Every frame has finished: the counts are the last frame's, if it
+        // counted (only a counting frame writes them).
+        if stats.counted.last() == Some(&true) {
+            stats.patches_per_level = self.method.multires().map(|m| m.patch_counts());
+        }
         Ok(stats)
     }
 

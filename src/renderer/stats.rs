@@ -18,7 +18,8 @@ pub struct FrameStats {
     pub wall_ms: Vec<f64>,
     /// From the first submission to the last frame's completion.
     pub elapsed_ms: f64,
-    /// Multiresolution patches per level of the last frame.
+    /// Multiresolution patches per level of the last frame, when it counted
+    /// (`None` without a multiresolution buffer or a counting last frame).
     pub patches_per_level: Option<Vec<u32>>,
 }
 
