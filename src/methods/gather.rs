@@ -288,8 +288,11 @@ impl MultiresMethod {
 }
 
 impl IndirectMethod for MultiresMethod {
-    fn record(&self, ctx: &FrameContext, p: &mut Profiler, _: usize) {
+    fn record_eye_space(&self, ctx: &FrameContext, p: &mut Profiler) {
         self.multires.record_refinement(ctx, p);
+    }
+
+    fn record(&self, ctx: &FrameContext, p: &mut Profiler, _: usize) {
         if let Some(l) = &self.light_pass {
             l.record(ctx, p);
         }

@@ -27,7 +27,8 @@ use anyhow::{bail, Result};
 
 /// One way of computing indirect light. Made once per run (`create`); records
 /// its passes into every frame after the RSM, G-buffer, direct light and (if
-/// it reads it) the RSM quadtree, and before the composite. Its GPU objects
+/// it reads it) the RSM quadtree, once per light view, and before the
+/// composite. Its GPU objects
 /// free themselves when it is dropped.
 pub trait IndirectMethod {
     /// Command buffers one frame of the method takes: the reference splits its
@@ -36,8 +37,14 @@ pub trait IndirectMethod {
         1
     }
 
-    /// Records submission `submission` (of `submissions()`) into `ctx.cmd`.
-    /// After the last one, `indirect` is written and in the `READ_ONLY` state.
+    /// Records the passes that depend on the camera alone (the eye-space
+    /// refinement), once per frame after the G-buffer: a frame with several
+    /// light views (point-light faces, several lights) shares them.
+    fn record_eye_space(&self, _ctx: &FrameContext, _profiler: &mut Profiler) {}
+
+    /// Records submission `submission` (of `submissions()`) of one light view
+    /// into `ctx.cmd`. After the last one, `indirect` is written and in the
+    /// `READ_ONLY` state.
     fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, submission: usize);
 
     /// Whether the frame must build the RSM quadtree (`passes::rsm_tree`) first.

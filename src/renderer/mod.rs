@@ -312,8 +312,9 @@ impl<'g> Renderer<'g> {
 
     /// Records `slot`'s frame: the G-buffer, then for each light view its
     /// RSM, direct light, light tree and method passes (summed by
-    /// `light-sum` when there are several), then the composite, tonemap and
-    /// what `extension` adds (the viewer's presentation).
+    /// `light-sum` when there are several; the method's camera-only passes
+    /// only in the first view), then the composite, tonemap and what
+    /// `extension` adds (the viewer's presentation).
     /// Records the frame of `slot`; a `counting` frame holds the statistics and
     /// occlusion queries (`Profiler`).
     fn record(
@@ -388,6 +389,12 @@ impl<'g> Renderer<'g> {
             self.direct.record(&ctx(cmds[c], v), p);
             if method.reads_rsm_tree() {
                 self.rsm_tree.record(&ctx(cmds[c], v), p);
+            }
+            if i == 0 {
+                // Camera-only passes, shared by every light view.
+                p.set_label(None);
+                method.record_eye_space(&ctx(cmds[c], v), p);
+                p.set_label(labels[i].clone());
             }
             for k in 0..chunks {
                 if k > 0 {
