@@ -87,7 +87,10 @@ fn patches_are_counted_only_in_a_counting_frame_and_match_the_gathered_texels() 
         .find(|p| p.name == "gather");
     let passed = gather.and_then(|p| p.samples_passed).unwrap();
     assert!(passed > 0);
-    assert_eq!(patches.iter().map(|&n| n as u64).sum::<u64>(), passed);
+    // Exact only with precise occlusion queries (else any non-zero count).
+    if gpu.features.precise_occlusion {
+        assert_eq!(patches.iter().map(|&n| n as u64).sum::<u64>(), passed);
+    }
     drop(r);
     assert_validation_clean(&gpu);
 }

@@ -257,8 +257,9 @@ pub fn written_for_gather(ctx: &FrameContext) {
 }
 
 /// A method that works through the multiresolution buffer: `multires-gather`,
-/// `isr`, `hisr` and `multires-splat`. Geometry mips and stencil refinement,
-/// the method's own light-space pass, the gather or splat, then upsampling.
+/// `isr`, `hisr` and `multires-splat`. Geometry mips and stencil refinement
+/// once per frame (`record_eye_space`); per light view the method's own
+/// light-space pass, the gather or splat, then upsampling.
 pub struct MultiresMethod {
     pub multires: Multires,
     light_pass: Option<Box<dyn LightSpacePass>>,

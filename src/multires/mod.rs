@@ -171,8 +171,8 @@ impl MultiresBuffer {
         })
     }
 
-    /// Patches per level of the last frame (read once the device is idle: every
-    /// frame in flight writes this one buffer).
+    /// Patches per level of the last counting frame (read once the device is
+    /// idle: every counting frame writes this one buffer).
     pub fn patch_counts(&self) -> Vec<u32> {
         let mut counts: Vec<u32> = self.patch_counts.read_pod();
         counts.truncate(self.levels as usize + 1);

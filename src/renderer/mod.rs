@@ -314,9 +314,8 @@ impl<'g> Renderer<'g> {
     /// RSM, direct light, light tree and method passes (summed by
     /// `light-sum` when there are several; the method's camera-only passes
     /// only in the first view), then the composite, tonemap and what
-    /// `extension` adds (the viewer's presentation).
-    /// Records the frame of `slot`; a `counting` frame holds the statistics and
-    /// occlusion queries (`Profiler`).
+    /// `extension` adds (the viewer's presentation). A `counting` frame holds
+    /// the statistics and occlusion queries (`Profiler`).
     fn record(
         &mut self,
         slot: usize,
