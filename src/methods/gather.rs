@@ -210,22 +210,13 @@ impl LightSpacePass for PatchListPass {
             // view or of the previous frame) and readback (copy) read the
             // buffer before it is overwritten.
             if self.kind == PatchList::IsrChosen {
-                barrier::memory(
+                barrier::zero_buffer(
                     gpu,
                     cmd,
-                    readers,
-                    vk::AccessFlags2::NONE,
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                );
-                unsafe { gpu.device.cmd_fill_buffer(cmd, self.buffer.buffer, 0, 4, 0) };
-                barrier::memory(
-                    gpu,
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    rw,
+                    self.buffer.buffer,
+                    4,
+                    (readers, vk::AccessFlags2::NONE),
+                    (vk::PipelineStageFlags2::COMPUTE_SHADER, rw),
                 );
             } else {
                 barrier::memory(

@@ -76,22 +76,16 @@ impl StencilRefinePass {
             if counting {
                 // The previous counting frame's atomics are done before the
                 // counts are reset (the host read them after its fence).
-                barrier::memory(
+                let fragment = vk::PipelineStageFlags2::FRAGMENT_SHADER;
+                let rw =
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+                barrier::zero_buffer(
                     gpu,
                     cmd,
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                );
-                d.cmd_fill_buffer(cmd, m.patch_counts.buffer, 0, vk::WHOLE_SIZE, 0);
-                barrier::memory(
-                    gpu,
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                    m.patch_counts.buffer,
+                    vk::WHOLE_SIZE,
+                    (fragment, vk::AccessFlags2::SHADER_STORAGE_WRITE),
+                    (fragment, rw),
                 );
             }
             begin_rendering(

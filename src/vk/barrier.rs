@@ -209,6 +209,24 @@ pub fn copies_to_host(gpu: &Gpu, cmd: vk::CommandBuffer) {
     );
 }
 
+/// Zeroes the first `size` bytes of `buffer` (`vk::WHOLE_SIZE`: all of it)
+/// once the accesses `after` (stage, access) are done, and makes the zeros
+/// visible to the accesses `before`.
+pub fn zero_buffer(
+    gpu: &Gpu,
+    cmd: vk::CommandBuffer,
+    buffer: vk::Buffer,
+    size: vk::DeviceSize,
+    after: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    before: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let transfer = vk::PipelineStageFlags2::ALL_TRANSFER;
+    let write = vk::AccessFlags2::TRANSFER_WRITE;
+    memory(gpu, cmd, after.0, after.1, transfer, write);
+    unsafe { gpu.device.cmd_fill_buffer(cmd, buffer, 0, size, 0) };
+    memory(gpu, cmd, transfer, write, before.0, before.1);
+}
+
 /// A global memory barrier (buffers, host visibility).
 pub fn memory(
     gpu: &Gpu,
