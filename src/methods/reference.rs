@@ -89,10 +89,8 @@ impl IndirectMethod for Reference {
             begin_rendering(
                 gpu,
                 cmd,
-                &Attachments {
-                    clear_colors: false,
-                    ..Attachments::simple(&[indirect.view], None, indirect.extent)
-                },
+                // Blended onto the previous chunks' sums (cleared before the first).
+                &Attachments::loaded(&[indirect.view], indirect.extent),
             );
             self.pipeline.bind(gpu, cmd, ctx.frame_set);
             gpu.device.cmd_push_constants(

@@ -111,11 +111,8 @@ impl GeometryMipsPass {
                 begin_rendering(
                     gpu,
                     cmd,
-                    &Attachments {
-                        // Every texel is written: nothing to clear.
-                        clear_colors: false,
-                        ..Attachments::simple(&views, None, m.level_extent(level))
-                    },
+                    // Every texel is written: nothing to clear.
+                    &Attachments::loaded(&views, m.level_extent(level)),
                 );
                 match (level, &self.above) {
                     (1, _) => self.level_one.bind(gpu, cmd, ctx.frame_set),

@@ -138,11 +138,8 @@ impl UpsamplePass {
             begin_rendering(
                 gpu,
                 cmd,
-                &Attachments {
-                    // Every pixel is written: nothing to clear.
-                    clear_colors: false,
-                    ..Attachments::simple(&[t.indirect.view], None, t.indirect.extent)
-                },
+                // Every pixel is written: nothing to clear.
+                &Attachments::loaded(&[t.indirect.view], t.indirect.extent),
             );
             self.level_zero.bind(gpu, cmd, ctx.frame_set);
             unsafe {

@@ -85,6 +85,15 @@ impl<'a> Attachments<'a> {
             stencil: None,
         }
     }
+
+    /// Single-layer color targets that keep what they hold (loaded, not
+    /// cleared: the draws write every texel or blend onto it), no depth.
+    pub fn loaded(colors: &'a [vk::ImageView], extent: vk::Extent2D) -> Self {
+        Self {
+            clear_colors: false,
+            ..Self::simple(colors, None, extent)
+        }
+    }
 }
 
 /// Starts dynamic rendering into `a` and sets viewport and scissor to its extent.
