@@ -1,6 +1,6 @@
 //! Per-pass GPU timings: the JSON written by `--timings` and the table the CLI prints.
 
-use crate::renderer::FrameStats;
+use crate::renderer::{median, FrameStats};
 use anyhow::{Context as _, Result};
 use serde::Serialize;
 use std::path::Path;
@@ -47,20 +47,6 @@ pub struct TimingReport {
     /// Animation time of the frame (sequences).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time: Option<f32>,
-}
-
-pub fn median(values: &[f64]) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
 }
 
 /// Identifies the run a report belongs to.
@@ -182,7 +168,7 @@ pub fn table(r: &TimingReport) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{build, median, RunInfo};
+    use super::{build, RunInfo};
     use crate::renderer::FrameStats;
     use crate::vk::profiler::{PassKind, PassSample};
 
@@ -237,12 +223,5 @@ mod tests {
         let timing = build(&INFO, &stats(&[(1.0, false), (3.0, false)]));
         assert_eq!(timing.passes[0].gpu_ms_median, Some(2.0));
         assert_eq!(timing.passes[0].samples_passed, None);
-    }
-
-    #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
-        assert_eq!(median(&[]), None);
     }
 }

@@ -27,7 +27,7 @@ impl FrameStats {
     /// Median over frames of the summed time of all passes, or of the passes
     /// that exist only for indirect light; `None` without timestamps.
     pub fn gpu_ms_median(&self, indirect_only: bool) -> Option<f64> {
-        crate::report::median(&self.gpu_ms_sums(indirect_only))
+        median(&self.gpu_ms_sums(indirect_only))
     }
 
     /// The least over frames of the same sums: on a shared or loaded
@@ -94,5 +94,34 @@ impl FrameStats {
                     .try_fold(0.0, |acc, ms| Some(acc + ms?))
             })
             .collect()
+    }
+}
+
+/// The median of `values` (the mean of the middle two for an even count);
+/// `None` when empty. Here, beside the frame numbers it summarizes, so that
+/// `FrameStats` needs nothing from `report`, which builds on it.
+pub fn median(values: &[f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
     }
 }

@@ -2,7 +2,7 @@
 //! sets against the bindings its shaders declare (`reflect`).
 
 use super::context::Shared;
-use super::pipeline::spirv;
+use super::shaders::spirv;
 use super::{reflect, Gpu};
 use anyhow::{bail, Context as _, Result};
 use ash::vk;

@@ -1,4 +1,5 @@
-//! Thin layers over ash: device, resources, barriers, pipelines, timing.
+//! Thin layers over ash: device, resources, barriers, uploads, shaders,
+//! pipelines, timing.
 
 pub mod barrier;
 pub mod context;
@@ -7,7 +8,9 @@ pub mod pipeline;
 pub mod profiler;
 pub mod reflect;
 pub mod resources;
+pub mod shaders;
 pub mod swapchain;
+mod upload;
 
 pub use context::{Gpu, GpuOptions, Validation};
 pub use resources::{Buffer, Image, ImageDesc, Sampler};

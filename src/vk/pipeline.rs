@@ -1,31 +1,15 @@
-//! Shader modules from the embedded SPIR-V, descriptor sets, and graphics
-//! pipelines for dynamic rendering.
+//! Shader modules from the embedded SPIR-V (`shaders`), and graphics and
+//! compute pipelines for dynamic rendering. Descriptor sets live in
+//! `descriptors` and are re-exported here, beside the pipelines they feed.
 
 use super::context::Shared;
 pub use super::descriptors::{check_bindings, Binding, BindingInfo, DescriptorSet, Resource};
+// Re-exported: `tests/layouts.rs` reads the embedded SPIR-V by this path.
+pub use super::shaders::{shader_names, spirv};
 use super::Gpu;
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use std::sync::Arc;
-
-mod embedded {
-    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
-}
-
-/// The SPIR-V words of `shaders/<name>`, compiled by `build.rs`.
-pub fn spirv(name: &str) -> Result<Vec<u32>> {
-    let bytes = embedded::SPIRV
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, b)| *b)
-        .ok_or_else(|| anyhow!("no compiled shader named {name} (is shaders/{name} present?)"))?;
-    Ok(ash::util::read_spv(&mut std::io::Cursor::new(bytes))?)
-}
-
-/// Names of every embedded shader.
-pub fn shader_names() -> impl Iterator<Item = &'static str> {
-    embedded::SPIRV.iter().map(|(n, _)| *n)
-}
 
 /// Map entries and data for 32-bit integer (or bool) specialization constants.
 fn specialization_data(constants: &[(u32, i32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {

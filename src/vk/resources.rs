@@ -1,6 +1,8 @@
 //! Images, buffers and samplers backed by gpu-allocator. Each frees itself
 //! when dropped; it holds the device (`Arc<Shared>`), so the device outlives it
-//! and an error half-way through setup leaks nothing.
+//! and an error half-way through setup leaks nothing. Nothing here records
+//! commands: filling a buffer through a staging copy (`Buffer::with_data`)
+//! needs a barrier, so it is in `upload`, above this module and `barrier`.
 
 use super::context::Shared;
 use super::Gpu;
@@ -273,48 +275,6 @@ impl Buffer {
         unsafe { gpu.device.bind_buffer_memory(buffer, memory, offset)? };
         gpu.name(buffer, name);
         Ok(out)
-    }
-
-    /// A device-local buffer filled with `data` through a staging copy.
-    pub fn with_data(
-        gpu: &Gpu,
-        name: &str,
-        data: &[u8],
-        usage: vk::BufferUsageFlags,
-    ) -> Result<Self> {
-        let dst = Self::new(
-            gpu,
-            name,
-            data.len() as u64,
-            usage | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuOnly,
-        )?;
-        let mut staging = Self::new(
-            gpu,
-            &format!("{name} (staging)"),
-            data.len() as u64,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-        )?;
-        staging.write(0, data);
-        gpu.run_once(|cmd| unsafe {
-            gpu.device.cmd_copy_buffer(
-                cmd,
-                staging.buffer,
-                dst.buffer,
-                &[vk::BufferCopy::default().size(data.len().max(1) as u64)],
-            );
-            // The copy's writes become visible to every later shader or vertex read.
-            super::barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                vk::AccessFlags2::MEMORY_READ,
-            );
-        })?;
-        Ok(dst)
     }
 
     /// Host-visible bytes (CpuToGpu and GpuToCpu buffers only).
