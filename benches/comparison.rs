@@ -6,26 +6,13 @@
 //! of the indirect and final images; writes `target/bench/comparison.json` and
 //! one PNG per method to `target/bench/comparison/`.
 
+use isr::bench::metrics::{geometry_mask, relative_rmse};
 use isr::readback::Readback;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
-
-fn relative_rmse(a: &[[f32; 4]], b: &[[f32; 4]], geometry: &[[f32; 4]]) -> f64 {
-    let (mut e, mut n) = (0.0f64, 0.0f64);
-    for ((x, y), p) in a.iter().zip(b).zip(geometry) {
-        if p[3] <= 0.0 {
-            continue;
-        }
-        for k in 0..3 {
-            e += (x[k] as f64 - y[k] as f64).powi(2);
-            n += (y[k] as f64).powi(2);
-        }
-    }
-    (e / n).sqrt()
-}
 
 fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(&GpuOptions::default())?;
@@ -34,7 +21,6 @@ fn main() -> anyhow::Result<()> {
         width: 256,
         height: 256,
         rsm_resolution: 256,
-        vpls: 256,
         ..Default::default()
     };
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench/comparison");
@@ -56,7 +42,7 @@ fn main() -> anyhow::Result<()> {
         eprintln!("{}: done", method.name());
         Ok((out, stats.gpu_ms_median(true).unwrap_or(f64::NAN)))
     };
-    let (reference, reference_ms) = run(Method::Reference, 1)?;
+    let (reference, reference_ms) = run(isr::methods::reference::KEY, 1)?;
     let traced = isr::pathtrace::render(
         &scene,
         &isr::pathtrace::PathTraceSettings {
@@ -69,21 +55,14 @@ fn main() -> anyhow::Result<()> {
         |_, _| {},
     );
     isr::output::write_png(&dir.join("pathtrace.png"), 256, 256, &traced.display)?;
-    let methods = [
-        Method::RsmGather,
-        Method::RsmSplat,
-        Method::RsmSplatRestricted,
-        Method::MultiresSplat,
-        Method::MultiresGather,
-        Method::Isr,
-        Method::Hisr,
-    ];
+    // The methods `isr bench` sweeps, at their defaults.
+    let methods = isr::bench::sweep::methods();
     let mut rows = Vec::new();
     println!(
         "{:<22} {:>12} {:>16} {:>14}",
         "method", "indirect ms", "indirect RMSE", "final RMSE"
     );
-    let geometry = &reference.position;
+    let geometry = &geometry_mask(&reference.position);
     for m in methods {
         let (out, ms) = run(m, 3)?;
         let ei = relative_rmse(&out.indirect, &reference.indirect, geometry);
@@ -104,7 +83,7 @@ fn main() -> anyhow::Result<()> {
     std::fs::write(
         dir.join("../comparison.json"),
         serde_json::to_string_pretty(
-            &json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": 256,
+            &json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": isr::methods::vpls::VPLS.get(&base),
             "reference_ms": reference_ms, "runs": rows}),
         )?,
     )?;

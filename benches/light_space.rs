@@ -10,9 +10,11 @@
 //! shared CPU the least disturbed frame is the steadiest measure, and rounds
 //! spread a slow spell over every row. Writes `target/bench/light_space.json`.
 
+use isr::methods::vpls::VPLS;
+use isr::methods::{hisr, multires_gather};
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
-use isr::settings::{LightTreeSettings, Method, RenderSettings};
+use isr::settings::RenderSettings;
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
 
@@ -57,58 +59,37 @@ fn main() -> anyhow::Result<()> {
         rsm_resolution: 256,
         ..Default::default()
     };
-    let with = |method, vpls, lt: LightTreeSettings| RenderSettings {
-        method,
-        vpls,
-        light_tree: lt,
-        ..base.clone()
+    let gather = |vpls| {
+        base.clone()
+            .with_method(multires_gather::KEY)
+            .with(&VPLS, vpls)
     };
-    let reference = run(
-        &gpu,
-        "dense (65536 VPLs)",
-        &with(Method::MultiresGather, 65536, Default::default()),
-        1,
-    )?;
+    let hisr = |tau| base.clone().with_method(hisr::KEY).with(&hisr::TAU, tau);
+    let reference = run(&gpu, "dense (65536 VPLs)", &gather(65536), 1)?;
     let mut configs: Vec<(String, RenderSettings)> = Vec::new();
     for n in [256, 1024, 4096] {
-        configs.push((
-            format!("multires-gather {n}"),
-            with(Method::MultiresGather, n, Default::default()),
-        ));
+        configs.push((format!("multires-gather {n}"), gather(n)));
     }
     configs.push((
         "isr (base 64)".into(),
-        with(Method::Isr, 256, Default::default()),
+        base.clone().with_method(isr::methods::isr::KEY),
     ));
     // The HISR curve (default tiles), then below 4096 VPLs' error, where HISR
     // needs patches finer than theirs (depth 6 is their level), depth 7; one
     // point without tiles (every fragment traverses from the roots) for
     // comparison.
     for tau in [0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005] {
-        let lt = LightTreeSettings {
-            tau,
-            ..Default::default()
-        };
-        configs.push((format!("hisr tau {tau}"), with(Method::Hisr, 256, lt)));
+        configs.push((format!("hisr tau {tau}"), hisr(tau)));
     }
     for tau in [0.5, 0.2, 0.1, 0.05, 0.02, 0.01] {
-        let lt = LightTreeSettings {
-            tau,
-            max_depth: Some(7),
-            ..Default::default()
-        };
         configs.push((
             format!("hisr tau {tau}, depth 7"),
-            with(Method::Hisr, 256, lt),
+            hisr(tau).with(&hisr::MAX_DEPTH, 7),
         ));
     }
-    let no_tiles = LightTreeSettings {
-        hisr_tile_level: 0,
-        ..Default::default()
-    };
     configs.push((
         "hisr tau 0.05, no tiles".into(),
-        with(Method::Hisr, 256, no_tiles),
+        hisr(0.05).with(&hisr::TILE_LEVEL, 0),
     ));
     // Rounds over every row in turn, each row's time the least over all its
     // frames: a slow spell of the shared machine then touches every row alike

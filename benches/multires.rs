@@ -9,7 +9,7 @@
 
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
-use isr::settings::{Method, RenderSettings};
+use isr::settings::RenderSettings;
 use isr::vk::{Gpu, GpuOptions};
 use serde_json::json;
 
@@ -18,7 +18,7 @@ fn gather_ms(stats: &isr::renderer::FrameStats, name: &str) -> f64 {
         .timed()
         .filter_map(|f| f.iter().find(|p| p.name == name)?.gpu_ms)
         .collect();
-    isr::report::median(&times).unwrap_or(f64::NAN)
+    isr::renderer::median(&times).unwrap_or(f64::NAN)
 }
 
 fn main() -> anyhow::Result<()> {
@@ -28,15 +28,13 @@ fn main() -> anyhow::Result<()> {
         width: 512,
         height: 512,
         rsm_resolution: 512,
-        method: Method::MultiresGather,
-        vpls: 256,
+        method: isr::methods::multires_gather::KEY,
         ..Default::default()
     };
     let mut report = serde_json::Map::new();
     let mut results = Vec::new();
     for stencil in [true, false] {
-        let mut s = base.clone();
-        s.multires.stencil = stencil;
+        let s = base.clone().with(&isr::multires::STENCIL, stencil);
         let mut r = Renderer::new(&gpu, &scene, &s)?;
         r.render_frames(1, |_| {})?;
         let frames = if stencil { 10 } else { 3 };

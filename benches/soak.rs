@@ -5,7 +5,7 @@
 //! figures after warm-up mean nothing leaks per frame.
 
 use isr::scene::cornell::cornell_box;
-use isr::settings::{Method, RenderSettings};
+use isr::settings::RenderSettings;
 use isr::soak;
 use isr::vk::{Gpu, GpuOptions};
 
@@ -22,20 +22,22 @@ fn main() -> anyhow::Result<()> {
     );
     println!("| method | frame | resident MiB | GPU allocated MiB | GPU blocks MiB (count) |");
     println!("| --- | ---: | ---: | ---: | ---: |");
-    for method in [RenderSettings::DEFAULT.method, Method::Hisr] {
+    for method in [RenderSettings::DEFAULT.method, isr::methods::hisr::KEY] {
         let settings = RenderSettings {
             width: 64,
             height: 64,
             rsm_resolution: 128,
-            vpls: 64,
             method,
             ..Default::default()
-        };
+        }
+        .with(&isr::methods::vpls::VPLS, 64);
         let started = std::time::Instant::now();
+        let bar = isr::progress::bar(frames as u64, "frames");
+        bar.set_message(method.name());
         let samples = soak::run(&gpu, &scene, &settings, frames, 100, |s| {
-            eprint!("\r{} frame {}/{frames}   ", method.name(), s.frame);
+            bar.set_position(s.frame as u64);
         })?;
-        eprintln!();
+        bar.finish_and_clear();
         let mib = |b: u64| b as f64 / (1 << 20) as f64;
         for s in samples
             .iter()

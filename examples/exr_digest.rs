@@ -22,7 +22,11 @@ fn read(path: &str) -> Result<Channels> {
     for layer in &image.layer_data {
         let layer_name = layer.attributes.layer_name.as_ref().map(|n| n.to_string());
         for channel in &layer.channel_data.list {
-            let name = format!("{}.{}", layer_name.clone().unwrap_or_default(), channel.name);
+            let name = format!(
+                "{}.{}",
+                layer_name.clone().unwrap_or_default(),
+                channel.name
+            );
             let samples = match &channel.sample_data {
                 FlatSamples::F32(v) => v.clone(),
                 FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
@@ -52,12 +56,20 @@ fn main() -> Result<()> {
         }
         [flag, a, b] if flag == "--compare" => {
             let (a, b) = (read(a)?, read(b)?);
-            if a.len() != b.len() || a.iter().zip(&b).any(|(x, y)| x.0 != y.0 || x.1.len() != y.1.len()) {
+            if a.len() != b.len()
+                || a.iter()
+                    .zip(&b)
+                    .any(|(x, y)| x.0 != y.0 || x.1.len() != y.1.len())
+            {
                 bail!("the two files have different layers, channels or sizes");
             }
             let mut worst = 0.0f64;
             for ((_, x), (_, y)) in a.iter().zip(&b) {
-                let peak = x.iter().chain(y).filter(|v| v.is_finite()).fold(0.0f32, |m, v| m.max(v.abs()));
+                let peak = x
+                    .iter()
+                    .chain(y)
+                    .filter(|v| v.is_finite())
+                    .fold(0.0f32, |m, v| m.max(v.abs()));
                 for (p, q) in x.iter().zip(y) {
                     if p.to_bits() != q.to_bits() {
                         let d = (p - q).abs() as f64 / (peak as f64).max(f64::MIN_POSITIVE);

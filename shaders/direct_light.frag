@@ -16,10 +16,10 @@ layout(set = 1, binding = 3) uniform sampler2DShadow rsm_depth;  // compare: GRE
 layout(location = 0) out vec4 out_radiance;  // rgb: W/(m^2 sr)
 
 float visibility(vec3 p, vec3 n, float cos_i) {
-    float res = float(run.size.z);
+    float res = float(run.rsm_resolution);
     // One RSM texel spans this many metres at the receiver's depth.
     float texel_world = shadow_texel_world(p);
-    vec4 clip = u.light_view_proj * vec4(p + n * (run.shadow.x * texel_world), 1.0);
+    vec4 clip = u.light_view_proj * vec4(p + n * (run.shadow_normal_offset * texel_world), 1.0);
     if (clip.w <= 0.0) return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
@@ -30,7 +30,7 @@ float visibility(vec3 p, vec3 n, float cos_i) {
     // (shadow_reference in light_types.glsl).
     float tan_theta = min(sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-3), 20.0);
     float ref = shadow_reference(ndc.z, tan_theta, texel_world);
-    float radius = run.shadow.z;
+    float radius = run.pcf_radius;
     float sum = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)
@@ -51,7 +51,7 @@ void main() {
     float r2;
     vec3 l = light_direction_from(p, r2);
     float cos_i = max(dot(n, l), 0.0);
-    vec3 radiance = albedo / PI * light_intensity_toward(p, u.light_kind.y) * cos_i / r2;
+    vec3 radiance = albedo / PI * light_intensity_toward(p, u.cube_face) * cos_i / r2;
     if (cos_i > 0.0) radiance *= visibility(p, n, cos_i);
     out_radiance = vec4(radiance, 1.0);
 }

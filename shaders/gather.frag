@@ -73,8 +73,9 @@ void patch_list(vec3 xi, vec3 ni) {
 // gives its form: C <= 2 I |V_j|^2 / (3 R^2 |V_ij|^2 + 2 |V_j|^2). Requiring
 // it to exceed tau:
 //   subdivide j  iff  |V_ij|^2 <= T |V_j|^2,  T = 2 (I - tau) / (3 tau R^2),
-// constant per frame (light_tree.x; `--tau` is tau / I, so T = 2 (1 - tau) /
-// (3 tau R^2)). The per-level factor: a patch k levels above the finest stands
+// constant per run (run.hisr_threshold; `--tau` is tau / I, so the host's
+// `hisr::subdivision_threshold` computes T = 2 (1 - tau) / (3 tau R^2), the
+// one place it is evaluated). The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
 // R^2 / 4^k and its threshold 4^k T. For cube faces and orthographic RSMs
 // the right-hand side differs: hisr_bound in light_types.glsl derives it.
@@ -118,7 +119,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
 
 // From the 2^s x 2^s patches of the start depth.
 void traverse(vec3 xi, vec3 ni) {
-    int start = run.light_levels.x;
+    int start = run.hisr_start_depth;
     int side = 1 << start;
     for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start));
 }
@@ -176,7 +177,7 @@ void main() {
         traverse_cut(xi, ni, p);
     }
     float is = 1.0;
-    if ((run.hierarchy.w & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(level, run.hierarchy.x, p)) {
+    if ((run.hierarchy_flags & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(level, run.levels, p)) {
         is = 0.0;
         e = vec3(0.0);
         evaluations = 0u;

@@ -15,7 +15,7 @@ layout(location = 1) out vec4 out_normal;    // xyz: unit world normal facing th
 layout(location = 2) out vec4 out_albedo;    // rgb: linear diffuse albedo
 
 void main() {
-    float view_depth = dot(in_world - u.camera_position.xyz, u.camera_forward.xyz);
+    float view_depth = dot(in_world - u.camera_position, u.camera_forward);
     out_position = vec4(in_world, max(view_depth, 1e-6));
     out_normal = vec4(facing_normal(in_normal), max(view_depth, 1e-6));
     out_albedo = vec4(material_albedo(draw.material, in_uv), 1.0);

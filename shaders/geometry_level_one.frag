@@ -20,7 +20,7 @@ layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;    // xyz: unit n
 // drivers as much as taken ones.
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    ivec2 size = ivec2(run.size.xy);
+    ivec2 size = ivec2(run.output_size);
     vec4 mean = vec4(0.0);
     vec3 normal = vec3(0.0);
     float coverage = 0.0;

@@ -32,8 +32,8 @@ layout(location = 4) out uint out_flags;
 const float BIG = 3.0e38;
 
 bool smooth_ranges(vec4 lo, vec4 hi) {
-    bool depth_ok = (hi.x - lo.x) < run.refine.x * lo.x;
-    bool normal_ok = length(hi.yzw - lo.yzw) < run.refine.y;
+    bool depth_ok = (hi.x - lo.x) < run.depth_threshold * lo.x;
+    bool normal_ok = length(hi.yzw - lo.yzw) < run.normal_chord;
     return depth_ok && normal_ok;
 }
 

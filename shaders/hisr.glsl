@@ -17,9 +17,9 @@ int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 
 // traversal and the tile cut test a node with one comparison and decide
 // exactly alike.
 float hisr_reach(LightPatch lp, ivec3 node) {
-    if (node.z >= run.light_levels.y || lp.position_area.w <= 0.0) return -1.0;
-    int mip = run.light_levels.w - node.z;
-    float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.light_tree.x);
+    if (node.z >= run.hisr_max_depth || lp.position_area.w <= 0.0) return -1.0;
+    int mip = run.rsm_top_level - node.z;
+    float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.hisr_threshold);
     if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
     return reach;
 }

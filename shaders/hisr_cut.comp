@@ -63,7 +63,7 @@ uint box_at(uint t) { return layout_.entries.x + 8u * t; }
 void write_finest_box(ivec2 tile) {
     int side = 1 << layout_.tiles[0].z;
     ivec2 origin = tile * side;
-    ivec2 end = min(origin + side, ivec2(run.size.xy));
+    ivec2 end = min(origin + side, ivec2(run.output_size));
     vec3 lo = EMPTY_LO, hi = EMPTY_HI;
     for (int y = origin.y; y < end.y; ++y) {
         for (int x = origin.x; x < end.x; ++x) {
@@ -115,7 +115,7 @@ void main() {
     uint base = layout_.entries[1 + level] + t * capacity;
     // Roots: the start depth's nodes for the coarsest level, else the parent
     // tile's traverse entries (its evaluate entries hold for this tile too).
-    int start = run.light_levels.x;
+    int start = run.hisr_start_depth;
     int side = 1 << start;
     uint roots = uint(side * side);
     uint parent_last = 0u;

@@ -26,8 +26,8 @@ layout(set = 1, binding = 3, std430) buffer ChosenPatches {
 };
 
 void main() {
-    int base = run.light_levels.z;
-    int top = run.light_levels.w;
+    int base = run.isr_base_level;
+    int top = run.rsm_top_level;
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, textureSize(rsm_position, base)))) return;
     int level = base;

@@ -13,7 +13,7 @@ layout(location = 0) flat out int out_level;
 
 void main() {
     int level = gl_InstanceIndex;
-    vec2 corner = vec2(run.size.xy >> uint(level)) / vec2(run.size.xy);
+    vec2 corner = vec2(run.output_size >> uint(level)) / vec2(run.output_size);
     // Two triangles: (0,0) (1,0) (0,1) and (1,0) (1,1) (0,1).
     const vec2 quad[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(1, 0), vec2(1, 1), vec2(0, 1));
     vec2 p = quad[gl_VertexIndex];

@@ -18,7 +18,7 @@ layout(push_constant) uniform Push { int mode; };
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(p, ivec2(run.size.xy)))) return;
+    if (any(greaterThanEqual(p, ivec2(run.output_size)))) return;
     vec4 d = imageLoad(direct, p);
     vec4 i = imageLoad(indirect, p);
     if (mode == 0) {

@@ -28,8 +28,8 @@ layout(set = 1, binding = 3, std430) writeonly buffer LightTree {
 };
 
 void main() {
-    int top = run.light_levels.w;  // mip of the root
-    int w = 1 << run.light_levels.y;  // 2^D patches per side at the max depth
+    int top = run.rsm_top_level;  // mip of the root
+    int w = 1 << run.hisr_max_depth;  // 2^D patches per side at the max depth
     int i = int(gl_GlobalInvocationID.y) * w + int(gl_GlobalInvocationID.x);
     int total = (4 * w * w - 1) / 3;
     if (gl_GlobalInvocationID.x >= uint(w) || i >= total) return;

@@ -6,13 +6,13 @@
 #define LIGHT_TYPES_GLSL
 #include "lighting.glsl"
 
-bool light_is_directional() { return u.light_kind.x == LIGHT_DIRECTIONAL; }
+bool light_is_directional() { return u.light_kind == LIGHT_DIRECTIONAL; }
 
 // Whether world point p belongs to this view's cube face: the face whose axis
 // is the largest component of p - light (ties go to x, then y, then z), so the
 // six faces partition the directions and no point is lit twice.
 bool in_cube_face(vec3 p, int face) {
-    vec3 d = p - u.light_position.xyz;
+    vec3 d = p - u.light_position;
     vec3 a = abs(d);
     int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
     float sign = (face & 1) == 0 ? 1.0 : -1.0;
@@ -23,12 +23,12 @@ bool in_cube_face(vec3 p, int face) {
 // the spot's cone or cube face `face` (the RSM's layer, or this view's face).
 // Directional: the irradiance E (W/m^2) on a surface facing the light.
 vec3 light_intensity_toward(vec3 p, int face) {
-    if (u.light_kind.x == LIGHT_SPOT) return spot_intensity(u, p);
-    if (light_is_directional()) return u.light_intensity.rgb;
+    if (u.light_kind == LIGHT_SPOT) return spot_intensity(u, p);
+    if (light_is_directional()) return u.light_intensity;
     if (!in_cube_face(p, face)) return vec3(0.0);
-    vec3 i = u.light_intensity.rgb;
-    if (u.light_position.w > 0.0) {
-        float r = length(p - u.light_position.xyz) / u.light_position.w;
+    vec3 i = u.light_intensity;
+    if (u.light_range > 0.0) {
+        float r = length(p - u.light_position) / u.light_range;
         i *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
     }
     return i;
@@ -39,9 +39,9 @@ vec3 light_intensity_toward(vec3 p, int face) {
 vec3 light_direction_from(vec3 p, out float r2) {
     if (light_is_directional()) {
         r2 = 1.0;
-        return -u.light_direction.xyz;
+        return -u.light_direction;
     }
-    vec3 to_light = u.light_position.xyz - p;
+    vec3 to_light = u.light_position - p;
     r2 = dot(to_light, to_light);
     return to_light * inversesqrt(r2);
 }
@@ -55,14 +55,14 @@ vec3 light_direction_from(vec3 p, out float r2) {
 // Phi_j = rho E a, A_j = a / cos_j, and no solid angle (dw_j = 0).
 void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 intensity,
                out float measure, out float area, out float dw) {
-    float res = float(run.size.z);
-    float half_extent = u.light_cone.z;
+    float res = float(run.rsm_resolution);
+    float half_extent = u.rsm_half_extent;
     float texel = 2.0 * half_extent / res;
     intensity = light_intensity_toward(x, face);
     bool lit = max(intensity.r, max(intensity.g, intensity.b)) > 0.0;
     if (light_is_directional()) {
         float a = texel * texel;
-        float cos_j = max(dot(n, -u.light_direction.xyz), min_cos);
+        float cos_j = max(dot(n, -u.light_direction), min_cos);
         measure = a;
         area = lit ? a / cos_j : 0.0;
         dw = 0.0;
@@ -72,7 +72,7 @@ void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 inte
     vec2 plane = (frag / res * 2.0 - 1.0) * half_extent;
     float cos_alpha = inversesqrt(1.0 + dot(plane, plane));
     dw = texel * texel * cos_alpha * cos_alpha * cos_alpha;
-    vec3 to_light = u.light_position.xyz - x;
+    vec3 to_light = u.light_position - x;
     float r2 = dot(to_light, to_light);
     float cos_j = max(dot(n, to_light * inversesqrt(r2)), min_cos);
     measure = dw;
@@ -86,19 +86,19 @@ void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 inte
 // -dz/z, the texel's angular size times the slope); orthographic depth is
 // linear over light_cone.w metres, so biases are lengths over that range.
 float shadow_texel_world(vec3 p) {
-    float res = float(run.size.z);
-    if (light_is_directional()) return 2.0 * u.light_cone.z / res;
-    float dist = dot(p - u.light_position.xyz, u.light_direction.xyz);
-    return 2.0 * u.light_cone.z * max(dist, 0.0) / res;
+    float res = float(run.rsm_resolution);
+    if (light_is_directional()) return 2.0 * u.rsm_half_extent / res;
+    float dist = dot(p - u.light_position, u.light_direction);
+    return 2.0 * u.rsm_half_extent * max(dist, 0.0) / res;
 }
 
 float shadow_reference(float z, float tan_theta, float texel_world) {
-    float res = float(run.size.z);
+    float res = float(run.rsm_resolution);
     if (light_is_directional()) {
-        return z + run.shadow.y + run.shadow.w * texel_world * tan_theta / u.light_cone.w;
+        return z + run.shadow_depth_bias + run.shadow_slope_bias * texel_world * tan_theta / u.rsm_depth_range;
     }
-    float texel_angle = 2.0 * u.light_cone.z / res;
-    return z * (1.0 + run.shadow.y + run.shadow.w * texel_angle * tan_theta);
+    float texel_angle = 2.0 * u.rsm_half_extent / res;
+    return z * (1.0 + run.shadow_depth_bias + run.shadow_slope_bias * texel_angle * tan_theta);
 }
 
 // The length that ISR's relative depth threshold multiplies for a child at
@@ -108,15 +108,16 @@ float shadow_reference(float z, float tan_theta, float texel_world) {
 // 90 degree perspective texel's at distance h: so h, which keeps the test's
 // meaning (depth offsets measured in texel footprints times R / 2).
 float validity_reach(vec3 p) {
-    if (light_is_directional()) return u.light_cone.z;
-    return distance(p, u.light_position.xyz);
+    if (light_is_directional()) return u.rsm_half_extent;
+    return distance(p, u.light_position);
 }
 
 // HISR (gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
 // (mean position pj, node xy at depth d: 2^d x 2^d patches across the RSM)
 // iff |V_ij|^2 <= 4^k * hisr_bound(...), k its levels above the finest.
-// t_finest = 2 (1 - tau) / (3 tau R^2) = dw_talk (1 - tau) / (pi tau) with
-// the talk's texel solid angle dw_talk = 2 pi / (3 R^2).
+// t_finest is T of gather.frag's derivation (run.hisr_threshold), which is
+// dw_talk (1 - tau) / (pi tau) with the talk's texel solid angle
+// dw_talk = 2 pi / (3 R^2).
 //
 // Spot (the talk): C_ij <= I dw / (pi |V_ij|^2 + dw |V_j|^2) > tau I / |V_j|^2
 //   iff |V_ij|^2 < dw (1 - tau) / (pi tau) |V_j|^2 = T |V_j|^2 with dw = dw_talk.
@@ -133,12 +134,12 @@ float validity_reach(vec3 p) {
 //   = 4^k T 6 h^2 / pi.
 float hisr_bound(vec3 pj, ivec3 node, float t_finest) {
     if (light_is_directional()) {
-        float h = u.light_cone.z;
+        float h = u.rsm_half_extent;
         return t_finest * 6.0 * h * h / PI;
     }
-    vec3 vj = pj - u.light_position.xyz;
+    vec3 vj = pj - u.light_position;
     float bound = t_finest * dot(vj, vj);
-    if (u.light_kind.x == LIGHT_POINT) {
+    if (u.light_kind == LIGHT_POINT) {
         // The patch's square on the face's image plane [-1, 1]^2, and its
         // point nearest the centre.
         float side = float(1 << node.z);

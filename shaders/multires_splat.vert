@@ -19,12 +19,12 @@ layout(location = 2) flat out vec3 out_normal;
 layout(location = 3) flat out vec3 out_flux;
 
 void main() {
-    int layers = run.hierarchy.x + 1;
+    int layers = run.levels + 1;
     int level = gl_InstanceIndex % layers;
     vec4 pos, nrm;
     vec3 flux;
     bool live = regular_vpl(gl_InstanceIndex / layers, pos, nrm, flux);
-    vec2 corner = vec2(run.size.xy >> uint(level)) / vec2(run.size.xy);
+    vec2 corner = vec2(run.output_size >> uint(level)) / vec2(run.output_size);
     const vec2 quad[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(1, 0), vec2(1, 1), vec2(0, 1));
     vec2 p = quad[gl_VertexIndex];
     gl_Position = live ? vec4(p * corner * 2.0 - 1.0, 0.0, 1.0) : vec4(2.0, 2.0, 0.0, 1.0);

@@ -33,7 +33,7 @@ void main() {
         ivec2 texel = min(ivec2(local * vec2(size)), size - 1);
         vec3 e = texelFetch(indirect, texel, 0).rgb;
         vec3 a = texelFetch(albedo, texel, 0).rgb;
-        encoded = srgb_encode(a / PI * e * run.exposure.x);
+        encoded = srgb_encode(a / PI * e * run.exposure);
     } else if (p.view == PRESENT_VIEW_HOST) {
         encoded = texture(host_view, local).rgb;
     } else {

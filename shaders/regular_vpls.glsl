@@ -6,14 +6,14 @@
 #ifndef REGULAR_VPLS_GLSL
 #define REGULAR_VPLS_GLSL
 
-int regular_vpl_count() { return run.hierarchy.z * run.hierarchy.z; }
+int regular_vpl_count() { return run.vpl_side * run.vpl_side; }
 
 // VPL j in row-major order; false when its patch saw nothing lit.
 bool regular_vpl(int j, out vec4 pos, out vec4 nrm, out vec3 flux) {
-    int k = run.hierarchy.y;
-    int side = run.hierarchy.z;
+    int k = run.vpl_level;
+    int side = run.vpl_side;
     ivec2 xy = ivec2(j % side, j / side);
-    if ((run.hierarchy.w & HIERARCHY_POINT_VPLS) != 0) {
+    if ((run.hierarchy_flags & HIERARCHY_POINT_VPLS) != 0) {
         int span = 1 << k;  // RSM texels per VPL side
         ivec2 t = xy * span + span / 2;
         float texels = float(span * span);

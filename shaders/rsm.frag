@@ -4,4 +4,4 @@
 // sections 2.3 and 2.4), drawn with scene.vert: see rsm_texel.glsl.
 #include "rsm_texel.glsl"
 
-void main() { write_rsm_texel(u.light_kind.y); }
+void main() { write_rsm_texel(u.cube_face); }

@@ -57,8 +57,8 @@ void main() {
         for (int i = 0; i < 4; ++i) {
             if (child_normal[i].w == PATCH_EMPTY) continue;
             float offset = abs(dot(child_position[i].xyz - position, normal));
-            float reach = run.light_tree.y * validity_reach(child_position[i].xyz);
-            one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > run.light_tree.z;
+            float reach = run.validity_depth * validity_reach(child_position[i].xyz);
+            one_surface = one_surface && offset < reach && dot(child_normal[i].xyz, normal) > run.validity_normal_cos;
         }
         state = one_surface ? PATCH_VALID : PATCH_INVALID;
     }

@@ -9,46 +9,73 @@
 struct FrameUniforms {
     mat4 camera_view_proj;  // world -> camera clip: reversed-Z, infinite far, y down
     mat4 light_view_proj;   // world -> RSM clip: same conventions, square, covers the outer cone
-    vec4 camera_position;   // xyz: world (m)
-    vec4 camera_forward;    // xyz: unit view direction
-    vec4 light_position;    // xyz: world (m); w: range (m), 0 = no range
-    vec4 light_direction;   // xyz: unit spot axis
-    vec4 light_intensity;   // rgb: color * intensity, W/sr (candela read as W/sr); w: I, the
-                            // peak of rgb (W/sr)
-    vec4 light_cone;        // x, y: KHR_lights_punctual lightAngleScale, lightAngleOffset (spot);
-                            // z: tan(RSM half field of view) (spot, point), or half the side of
-                            // the orthographic RSM (m, directional); w: the orthographic RSM's
-                            // depth range (m, directional)
-    ivec4 light_kind;       // x: LIGHT_*; y: cube face of a point light (0..5: +x, -x, +y, -y, +z, -z);
-                            // z: index of the light in the scene; w: unused
+    vec3 camera_position;   // world (m)
+    float pad0;
+    vec3 camera_forward;    // unit view direction
+    float pad1;
+    vec3 light_position;    // world (m)
+    float light_range;      // m, 0 = no range
+    vec3 light_direction;   // unit spot axis, or the directional light's direction
+    int light_kind;         // LIGHT_*: what this frame set's RSM is rendered from
+    vec3 light_intensity;   // color * intensity, W/sr (candela read as W/sr)
+    float light_peak;       // I, the peak of light_intensity (W/sr)
+    float cone_scale;       // spot: KHR_lights_punctual lightAngleScale
+    float cone_offset;      // spot: KHR_lights_punctual lightAngleOffset
+    float rsm_half_extent;  // tan(RSM half field of view) (spot, point), or half the side
+                            // of the orthographic RSM (m, directional)
+    float rsm_depth_range;  // the orthographic RSM's depth range (m, directional)
+    int cube_face;          // a point light's cube face (0..5: +x, -x, +y, -y, +z, -z)
+    int light_index;        // the light's index in the scene
+    int pad2;
+    int pad3;
     mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
 };
 
-// light_kind.x: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
+// light_kind: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
 const int LIGHT_SPOT = 0;         // perspective, the square around the outer cone
 const int LIGHT_POINT = 1;        // one 90 degree cube face; six make the point light
 const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 
 // What is fixed for a run: sizes, thresholds, levels (std140 uniform block,
-// set 0 binding 1, written once).
+// set 0 binding 1, written once). Each group is filled by the module that
+// owns its parameters (named after the group), from the one function that
+// derives each value.
 struct RunUniforms {
-    vec4 shadow;            // x: normal offset (RSM texels); y: constant relative depth bias;
-                            // z: PCF tap spacing (texels); w: slope bias (texels along the slope)
-    vec4 exposure;          // x: multiplier applied before the PNG's sRGB encoding
-    uvec4 size;             // x, y: output width, height; z: RSM resolution R
-    vec4 refine;            // multiresolution buffer (docs/algorithm.md section 3): x: depth threshold
-                            // (relative depth range, (max - min) / min); y: normal threshold (chord
-                            // length |n_max - n_min| of the component box, 2 sin(angle / 2))
-    ivec4 hierarchy;        // x: coarsest level L; y: RSM quadtree level k of the VPLs;
-                            // z: VPLs per side sqrt(N); w: flags, see HIERARCHY_*
-    vec4 light_tree;        // light-space hierarchy (docs/algorithm.md sections 2 and 4): x: HISR's T at
-                            // the finest level, 2 (1 - tau) / (3 tau R^2); y: patch validity depth
-                            // threshold (relative distance to the light); z: validity normal
-                            // threshold (cosine); w: unused
-    ivec4 light_levels;     // x: HISR start depth (2^x x 2^x patches); y: HISR max depth;
-                            // z: ISR base level (RSM mip); w: log2 R, the top mip (one patch)
-    vec4 splat;             // x: restricted-splat threshold (irradiance, W/m^2)
+    // Shadows of the direct light (frame/uniforms.rs, RenderSettings).
+    float shadow_normal_offset;   // RSM texels at the receiver
+    float shadow_depth_bias;      // constant, relative to the distance to the light
+    float pcf_radius;             // PCF tap spacing (RSM texels)
+    float shadow_slope_bias;      // RSM texels along the receiver's slope
+    // Sizes (frame/uniforms.rs).
+    uvec2 output_size;            // width, height (pixels)
+    uint rsm_resolution;          // R
+    int rsm_top_level;            // log2 R: the RSM quadtree's root (one patch)
+    float exposure;               // multiplier applied before the PNG's sRGB encoding
+    // The eye-space hierarchy (multires/mod.rs, docs/algorithm.md section 3).
+    int levels;                   // coarsest level L
+    float depth_threshold;        // relative view-depth range, (max - min) / min
+    float normal_chord;           // normal threshold as the chord |n_max - n_min| of
+                                  // the normals' component box, 2 sin(angle / 2)
+    int hierarchy_flags;          // HIERARCHY_*
+    // The regular VPLs (methods/vpls.rs): level vpl_level of the RSM quadtree,
+    // vpl_side x vpl_side of them.
+    int vpl_level;
+    int vpl_side;
+    // Patch validity in the RSM quadtree (passes/rsm_tree.rs, docs/algorithm.md section 4).
+    float validity_depth;         // relative to the distance to the light
+    float validity_normal_cos;    // cosine of the angle threshold
+    // Basic ISR (methods/isr.rs).
+    int isr_base_level;           // RSM quadtree level (mip) of the base
+    // HISR (methods/hisr.rs, docs/algorithm.md section 4.3).
+    float hisr_threshold;         // T at the finest level (hisr::subdivision_threshold;
+                                  // gather.frag derives the test)
+    int hisr_start_depth;         // traversal starts from 2^s x 2^s patches
+    int hisr_max_depth;           // and subdivides down to 2^d x 2^d
+    // Restricted splats (methods/rsm_splat.rs).
+    float splat_threshold;        // irradiance bound, W/m^2
+    int pad0;
+    int pad1;
 };
 
 // Where one mesh instance is this frame (std430, set 0 binding 2, one per
@@ -101,7 +128,7 @@ struct HisrCutHeader {
 // A tile whose cut did not fit: its fragments traverse from the roots.
 const uint HISR_CUT_OVERFLOW = 4294967295u;
 
-// hierarchy.w bits.
+// RunUniforms::hierarchy_flags bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
 // (Bit 2 is free: nearest or interpolated upsampling is a specialisation
 // constant of upsample.comp.)

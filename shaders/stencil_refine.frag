@@ -20,6 +20,6 @@ layout(constant_id = 0) const bool COUNT = true;
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    if (!is_patch(level, run.hierarchy.x, p)) discard;
+    if (!is_patch(level, run.levels, p)) discard;
     if (COUNT) atomicAdd(patches_per_level[level], 1u);
 }

@@ -14,6 +14,6 @@ vec3 srgb_encode(vec3 c) {
 }
 
 void main() {
-    vec3 c = texelFetch(final_radiance, ivec2(gl_FragCoord.xy), 0).rgb * run.exposure.x;
+    vec3 c = texelFetch(final_radiance, ivec2(gl_FragCoord.xy), 0).rgb * run.exposure;
     out_color = vec4(srgb_encode(c), 1.0);
 }

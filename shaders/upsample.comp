@@ -36,9 +36,9 @@ layout(push_constant) uniform Push { int level; };
 // Same surface: view depths within twice the refinement's relative depth
 // threshold and normals within twice its angle, both texels with geometry.
 bool same_surface(vec4 mean_a, vec4 normal_a, vec4 mean_b, vec4 normal_b) {
-    float depth_ok = abs(mean_a.w - mean_b.w) - 2.0 * run.refine.x * min(mean_a.w, mean_b.w);
+    float depth_ok = abs(mean_a.w - mean_b.w) - 2.0 * run.depth_threshold * min(mean_a.w, mean_b.w);
     float chord = length(normal_a.xyz - normal_b.xyz);
-    return normal_a.w > 0.0 && normal_b.w > 0.0 && depth_ok <= 0.0 && chord <= 2.0 * run.refine.y;
+    return normal_a.w > 0.0 && normal_b.w > 0.0 && depth_ok <= 0.0 && chord <= 2.0 * run.normal_chord;
 }
 
 // Writes the taps of texel p of `level` (final value v, geometry mean and

@@ -12,7 +12,7 @@
 const float PULLED = 0.5;
 const float PUSHED = 0.75;
 
-ivec2 level_size(int l) { return ivec2(run.size.xy) >> l; }
+ivec2 level_size(int l) { return ivec2(run.output_size) >> l; }
 
 bool inside(ivec2 q, int l) { return all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, level_size(l))); }
 

@@ -20,7 +20,7 @@ layout(set = 1, binding = 3, std430) writeonly buffer VplList {
 #include "regular_vpls.glsl"
 
 void main() {
-    int side = run.hierarchy.z;
+    int side = run.vpl_side;
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(xy, ivec2(side)))) return;
     int j = xy.y * side + xy.x;

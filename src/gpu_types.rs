@@ -11,50 +11,75 @@ use bytemuck::{Pod, Zeroable};
 pub struct FrameUniforms {
     pub camera_view_proj: [[f32; 4]; 4],
     pub light_view_proj: [[f32; 4]; 4],
-    pub camera_position: [f32; 4],
-    pub camera_forward: [f32; 4],
-    /// w: range in metres, 0 = none.
-    pub light_position: [f32; 4],
-    pub light_direction: [f32; 4],
-    /// rgb: color * intensity in W/sr; w: the peak of rgb, I.
-    pub light_intensity: [f32; 4],
-    /// x, y: KHR angle scale and offset; z: tan(RSM half fov), or half the
-    /// orthographic RSM's side (m); w: the orthographic depth range (m).
-    pub light_cone: [f32; 4],
-    /// x: `LIGHT_*`; y: cube face; z: light index.
-    pub light_kind: [i32; 4],
+    pub camera_position: [f32; 3],
+    pub pad0: f32,
+    pub camera_forward: [f32; 3],
+    pub pad1: f32,
+    pub light_position: [f32; 3],
+    /// Metres, 0 = none.
+    pub light_range: f32,
+    pub light_direction: [f32; 3],
+    /// `LIGHT_*`.
+    pub light_kind: i32,
+    /// Color * intensity in W/sr.
+    pub light_intensity: [f32; 3],
+    /// The peak of `light_intensity`, I.
+    pub light_peak: f32,
+    /// KHR angle scale and offset (spot).
+    pub cone_scale: f32,
+    pub cone_offset: f32,
+    /// tan(RSM half fov), or half the orthographic RSM's side (m).
+    pub rsm_half_extent: f32,
+    /// The orthographic RSM's depth range (m).
+    pub rsm_depth_range: f32,
+    pub cube_face: i32,
+    pub light_index: i32,
+    pub pad2: i32,
+    pub pad3: i32,
     /// Point lights: world -> clip of each cube face, for the layered draw.
     pub cube_view_proj: [[[f32; 4]; 4]; 6],
 }
 
-/// `light_kind.x` values, as in `shaders/shared.glsl`.
+/// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.
 pub const LIGHT_SPOT: i32 = 0;
 pub const LIGHT_POINT: i32 = 1;
 pub const LIGHT_DIRECTIONAL: i32 = 2;
 
-/// `RunUniforms` (std140): what is fixed for a run.
+/// `RunUniforms` (std140): what is fixed for a run. Each group is filled by
+/// the module that owns its parameters (`shaders/shared.glsl` names them).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RunUniforms {
-    /// x: normal offset (RSM texels); y: constant relative depth bias; z: PCF tap
-    /// spacing (texels); w: slope-scaled bias (texels along the slope).
-    pub shadow: [f32; 4],
-    /// x: exposure for the PNG.
-    pub exposure: [f32; 4],
-    /// x, y: output size; z: RSM resolution.
-    pub size: [u32; 4],
-    /// x: relative depth threshold; y: normal threshold as a chord length.
-    pub refine: [f32; 4],
-    /// x: coarsest level L; y: VPL level k of the RSM quadtree; z: VPLs per
-    /// side; w: `HIERARCHY_*` flags.
-    pub hierarchy: [i32; 4],
-    /// x: HISR's T at the finest level; y: patch validity depth threshold
-    /// (relative distance to the light); z: validity normal threshold (cosine).
-    pub light_tree: [f32; 4],
-    /// x: HISR start depth; y: HISR max depth; z: ISR base mip; w: log2 R.
-    pub light_levels: [i32; 4],
-    /// x: restricted-splat threshold (W/m^2).
-    pub splat: [f32; 4],
+    pub shadow_normal_offset: f32,
+    pub shadow_depth_bias: f32,
+    pub pcf_radius: f32,
+    pub shadow_slope_bias: f32,
+    pub output_size: [u32; 2],
+    pub rsm_resolution: u32,
+    pub rsm_top_level: i32,
+    pub exposure: f32,
+    /// The eye-space hierarchy (`multires::write_uniforms`).
+    pub levels: i32,
+    pub depth_threshold: f32,
+    pub normal_chord: f32,
+    /// `HIERARCHY_*` bits.
+    pub hierarchy_flags: i32,
+    /// The regular VPLs (`methods::vpls::RegularVpls`).
+    pub vpl_level: i32,
+    pub vpl_side: i32,
+    /// Patch validity (`passes::rsm_tree::write_uniforms`).
+    pub validity_depth: f32,
+    pub validity_normal_cos: f32,
+    /// Basic ISR (`methods::isr`).
+    pub isr_base_level: i32,
+    /// HISR (`methods::hisr`).
+    pub hisr_threshold: f32,
+    pub hisr_start_depth: i32,
+    pub hisr_max_depth: i32,
+    /// Restricted splats (`methods::rsm_splat`).
+    pub splat_threshold: f32,
+    pub pad0: i32,
+    pub pad1: i32,
 }
 
 /// `InstanceTransform` (std430): where one mesh instance is this frame.
@@ -122,7 +147,7 @@ pub const PATCH_EMPTY: f32 = 0.0;
 pub const PATCH_VALID: f32 = 1.0;
 pub const PATCH_INVALID: f32 = -1.0;
 
-/// `hierarchy.w` bits, as in `shaders/shared.glsl`.
+/// `RunUniforms::hierarchy_flags` bits, as in `shaders/shared.glsl`.
 pub const HIERARCHY_POINT_VPLS: i32 = 1;
 pub const HIERARCHY_STENCIL_OFF: i32 = 4;
 

@@ -17,6 +17,7 @@ pub mod multires;
 pub mod output;
 pub mod passes;
 pub mod pathtrace;
+pub mod progress;
 pub mod readback;
 pub mod renderer;
 pub mod report;

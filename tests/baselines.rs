@@ -3,7 +3,8 @@
 mod common;
 
 use common::*;
-use isr::multires::MultiresSettings;
+use isr::methods::{reference, rsm_splat, vpls::VPLS};
+use isr::multires::{DEPTH_THRESHOLD, NORMAL_THRESHOLD};
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};
@@ -13,10 +14,10 @@ fn settings(method: Method) -> RenderSettings {
         width: 96,
         height: 80,
         rsm_resolution: 64,
-        vpls: 64,
         method,
         ..Default::default()
     }
+    .with(&VPLS, 64)
 }
 
 fn indirect_of(
@@ -52,16 +53,11 @@ fn assert_same(name: &str, a: &[[f32; 4]], b: &[[f32; 4]], tolerance: f64) {
 #[test]
 fn rsm_gather_rsm_splat_and_level_zero_multires_gather_agree() {
     let gpu = gpu();
-    let (gather, _) = indirect_of(&gpu, &settings(Method::RsmGather));
-    let (splat, _) = indirect_of(&gpu, &settings(Method::RsmSplat));
-    let level_zero = RenderSettings {
-        multires: MultiresSettings {
-            depth_threshold: 0.0,
-            normal_threshold_deg: 0.0,
-            ..Default::default()
-        },
-        ..settings(Method::MultiresGather)
-    };
+    let (gather, _) = indirect_of(&gpu, &settings(Method::new("rsm-gather")));
+    let (splat, _) = indirect_of(&gpu, &settings(Method::new("rsm-splat")));
+    let level_zero = settings(Method::new("multires-gather"))
+        .with(&DEPTH_THRESHOLD, 0.0)
+        .with(&NORMAL_THRESHOLD, 0.0);
     let (multires, _) = indirect_of(&gpu, &level_zero);
     assert_same("rsm-splat vs rsm-gather", &splat, &gather, 1e-5);
     assert_same(
@@ -79,7 +75,7 @@ fn rsm_gather_rsm_splat_and_level_zero_multires_gather_agree() {
 #[test]
 fn restricted_splats_drop_at_most_n_times_the_threshold_per_pixel() {
     let gpu = gpu();
-    let (full, full_stats) = indirect_of(&gpu, &settings(Method::RsmSplat));
+    let (full, full_stats) = indirect_of(&gpu, &settings(Method::new("rsm-splat")));
     let fragments = |s: &[isr::vk::profiler::PassSample]| {
         s.iter()
             .find(|p| p.name == "rsm-splat")
@@ -87,13 +83,10 @@ fn restricted_splats_drop_at_most_n_times_the_threshold_per_pixel() {
             .samples_passed
             .unwrap()
     };
-    let n = settings(Method::RsmSplat).vpls as f32;
+    let n = VPLS.get(&settings(Method::new("rsm-splat"))) as f32;
     let mut previous = fragments(&full_stats);
     for t in [0.01f32, 0.05, 0.5] {
-        let s = RenderSettings {
-            splat_threshold: t,
-            ..settings(Method::RsmSplatRestricted)
-        };
+        let s = settings(Method::new("rsm-splat-restricted")).with(&rsm_splat::THRESHOLD, t);
         let (cut, cut_stats) = indirect_of(&gpu, &s);
         let shaded = fragments(&cut_stats);
         assert!(
@@ -123,8 +116,8 @@ fn restricted_splats_drop_at_most_n_times_the_threshold_per_pixel() {
 #[test]
 fn multires_splat_equals_multires_gather() {
     let gpu = gpu();
-    let (gather, _) = indirect_of(&gpu, &settings(Method::MultiresGather));
-    let (splat, stats) = indirect_of(&gpu, &settings(Method::MultiresSplat));
+    let (gather, _) = indirect_of(&gpu, &settings(Method::new("multires-gather")));
+    let (splat, stats) = indirect_of(&gpu, &settings(Method::new("multires-splat")));
     assert_same("multires-splat vs multires-gather", &splat, &gather, 1e-5);
     assert!(stats.iter().any(|p| p.name == "splat"));
 }
@@ -135,15 +128,15 @@ fn reference_in_chunks_equals_rsm_gather_with_every_texel() {
     let rsm = 32;
     let gather = RenderSettings {
         rsm_resolution: rsm,
-        vpls: rsm * rsm,
-        ..settings(Method::RsmGather)
-    };
+        ..settings(Method::new("rsm-gather"))
+    }
+    .with(&VPLS, rsm * rsm);
     let reference = RenderSettings {
         rsm_resolution: rsm,
-        // 96 x 80 pixels x 100 VPLs per submission: 11 chunks for 1024 VPLs.
-        reference_chunk: 96 * 80 * 100,
-        ..settings(Method::Reference)
-    };
+        ..settings(Method::new("reference"))
+    }
+    // 96 x 80 pixels x 100 VPLs per submission: 11 chunks for 1024 VPLs.
+    .with(&reference::CHUNK, 96 * 80 * 100);
     let mut r = Renderer::new(&gpu, &cornell_box(), &reference).unwrap();
     let mut submissions = 0;
     let stats = r.render_frames(1, |p| submissions = p.submissions).unwrap();

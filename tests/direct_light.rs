@@ -29,7 +29,7 @@ fn plane_lit_by_spot_matches_formula_including_cone_edge() {
         width: 256,
         height: 256,
         rsm_resolution: 1024,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1).readback;
@@ -99,7 +99,7 @@ fn point_behind_occluder_is_in_shadow_and_point_beside_it_is_lit() {
         width: 256,
         height: 256,
         rsm_resolution: 512,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1);

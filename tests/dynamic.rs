@@ -12,8 +12,7 @@ fn settings() -> RenderSettings {
         width: 64,
         height: 64,
         rsm_resolution: 64,
-        vpls: 64,
-        method: Method::Hisr,
+        method: Method::new("hisr"),
         ..Default::default()
     }
 }

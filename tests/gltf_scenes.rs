@@ -217,7 +217,7 @@ fn base_color_texture_multiplies_the_albedo() {
         width: 128,
         height: 128,
         rsm_resolution: 64,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     };
     let out = render(&gpu, &scene, &settings, 1);

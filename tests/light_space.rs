@@ -5,18 +5,17 @@ mod common;
 use common::*;
 use glam::Vec3;
 use isr::gpu_types::{HISR_INVALID_TAU_SCALE, PATCH_INVALID};
-use isr::multires::MultiresSettings;
+use isr::methods::{hisr, isr::BASE, vpls::VPLS};
+use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
 use isr::scene::{cornell::cornell_box, Camera};
-use isr::settings::{LightTreeSettings, Method, RenderSettings};
+use isr::settings::{Method, RenderSettings};
 
-fn settings(method: Method, rsm: u32, light_tree: LightTreeSettings) -> RenderSettings {
+fn settings(method: Method, rsm: u32) -> RenderSettings {
     RenderSettings {
         width: 64,
         height: 64,
         rsm_resolution: rsm,
         method,
-        light_tree,
-        multires: MultiresSettings::default(),
         ..Default::default()
     }
 }
@@ -47,20 +46,15 @@ fn hisr_converges_to_the_dense_gather_as_tau_falls() {
     let dense = render_multires(
         &gpu,
         &scene,
-        &RenderSettings {
-            vpls: rsm * rsm,
-            ..settings(Method::MultiresGather, rsm, LightTreeSettings::default())
-        },
+        &settings(Method::new("multires-gather"), rsm).with(&VPLS, rsm * rsm),
     );
     let mut errors = Vec::new();
     let mut evaluations = Vec::new();
     for tau in [0.5, 0.1, 0.02, 0.004, 0.0008, 0.00001] {
-        let lt = LightTreeSettings {
-            tau,
-            max_depth: Some(6), // log2(64): down to single texels
-            ..Default::default()
-        };
-        let out = render_multires(&gpu, &scene, &settings(Method::Hisr, rsm, lt));
+        let s = settings(hisr::KEY, rsm)
+            .with(&hisr::TAU, tau)
+            .with(&hisr::MAX_DEPTH, 6); // log2(64): down to single texels
+        let out = render_multires(&gpu, &scene, &s);
         errors.push(relative_rmse(&out, &dense));
         evaluations.push(isr::debug_view::light_patch_stats(&out.multires, None).per_patch_mean);
     }
@@ -89,14 +83,11 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
     let gpu = gpu();
     let scene = cornell_box();
     let base = 16;
-    let no_merges = LightTreeSettings {
-        isr_base: base,
-        depth_threshold: 0.0,
-        normal_threshold_deg: 0.0,
-        ..Default::default()
-    };
-    let mut r =
-        isr::renderer::Renderer::new(&gpu, &scene, &settings(Method::Isr, 128, no_merges)).unwrap();
+    let no_merges = settings(Method::new("isr"), 128)
+        .with(&BASE, base)
+        .with(&VALIDITY_DEPTH, 0.0)
+        .with(&VALIDITY_NORMAL, 0.0);
+    let mut r = isr::renderer::Renderer::new(&gpu, &scene, &no_merges).unwrap();
     r.render_frames(1, |_| {}).unwrap();
     let chosen = r.isr_chosen().unwrap().unwrap();
     let isr_indirect = r.readback().unwrap().indirect;
@@ -105,12 +96,9 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
     let regular = render_multires(
         &gpu,
         &scene,
-        &RenderSettings {
-            vpls: base * base,
-            ..settings(Method::MultiresGather, 128, LightTreeSettings::default())
-        },
+        &settings(Method::new("multires-gather"), 128).with(&VPLS, base * base),
     );
-    let base_mip = (128 / base).ilog2() as f32;
+    let base_mip = (128u32 / base).ilog2() as f32;
     assert!(
         chosen.iter().all(|p| p.normal[3] == base_mip),
         "every chosen patch is a base patch"
@@ -140,14 +128,7 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
 #[test]
 fn isr_chosen_patches_partition_the_rsm_flux() {
     let gpu = gpu();
-    let s = settings(
-        Method::Isr,
-        128,
-        LightTreeSettings {
-            isr_base: 32,
-            ..Default::default()
-        },
-    );
+    let s = settings(Method::new("isr"), 128).with(&BASE, 32);
     let mut r = isr::renderer::Renderer::new(&gpu, &cornell_box(), &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
     let chosen = r.isr_chosen().unwrap().unwrap();
@@ -206,12 +187,12 @@ fn no_nan_or_inf_in_degenerate_configurations() {
         ("light on the floor", grazing),
     ] {
         for method in [
-            Method::None,
-            Method::MultiresGather,
-            Method::Isr,
-            Method::Hisr,
+            Method::new("none"),
+            Method::new("multires-gather"),
+            Method::new("isr"),
+            Method::new("hisr"),
         ] {
-            let s = settings(method, 64, LightTreeSettings::default());
+            let s = settings(method, 64);
             let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
             r.render_frames(1, |_| {}).unwrap();
             let rb = r.readback().unwrap();
@@ -290,11 +271,7 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
     let gpu = gpu();
     let rsm = 32u32;
     let scene = cornell_box();
-    let lt = LightTreeSettings {
-        max_depth: Some(4),
-        ..Default::default()
-    };
-    let s = settings(Method::Hisr, rsm, lt);
+    let s = settings(hisr::KEY, rsm).with(&hisr::MAX_DEPTH, 4);
     let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
     let packed = r.hisr_packed_tree().unwrap().expect("hisr packs its tree");
@@ -302,9 +279,9 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
     drop(r);
     assert_validation_clean(&gpu);
     let top = rsm.trailing_zeros() as usize;
-    let max_depth = s.hisr_max_depth() as usize;
+    let max_depth = hisr::MAX_DEPTH.get(&s) as usize;
     assert!(max_depth < top, "some depths should never split");
-    let t = isr::methods::hisr::subdivision_threshold(s.light_tree.tau, rsm) as f64;
+    let t = hisr::subdivision_threshold(hisr::TAU.get(&s), rsm) as f64;
     let light = scene.lights[0].position.as_dvec3();
     let side = 1usize << max_depth;
     assert_eq!(packed.len(), (4 * side * side - 1) / 3);
@@ -387,23 +364,19 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
         ("point + directional", two_lights, 0.05, 3),
     ];
     for (label, scene, tau, tile_level) in cases {
-        let with = |k| RenderSettings {
-            width: 80,
-            height: 48,
-            rsm_resolution: 64,
-            method: Method::Hisr,
-            light_tree: LightTreeSettings {
-                tau,
-                hisr_tile_level: k,
+        let with = |k| {
+            RenderSettings {
+                width: 80,
+                height: 48,
+                rsm_resolution: 64,
+                method: Method::new("hisr"),
                 ..Default::default()
-            },
+            }
+            .with(&hisr::TAU, tau)
+            .with(&hisr::TILE_LEVEL, k)
             // Levels 0-4: with K = 1 the cut levels' tiles are 2, 4 and 8
             // pixels a side, and level 4's patches are coarser than all.
-            multires: MultiresSettings {
-                levels: Some(4),
-                ..Default::default()
-            },
-            ..Default::default()
+            .with(&isr::multires::LEVELS, 4)
         };
         let tiled = with(tile_level);
         if tau < 1e-3 {
@@ -453,10 +426,10 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
 #[test]
 fn hisr_with_tiles_is_deterministic() {
     let gpu = gpu();
-    let s = settings(Method::Hisr, 64, LightTreeSettings::default());
+    let s = settings(Method::new("hisr"), 64);
     let a = render_multires(&gpu, &cornell_box(), &s);
     let b = render_multires(&gpu, &cornell_box(), &s);
-    assert!(s.light_tree.hisr_tile_level > 0);
+    assert!(hisr::TILE_LEVEL.get(&s) > 0);
     assert_eq!(a.readback.indirect, b.readback.indirect);
 }
 

@@ -5,9 +5,10 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec3};
+use isr::methods::{hisr, isr::BASE, reference, vpls::VPLS};
 use isr::renderer::Renderer;
 use isr::scene::{cornell::cornell_box, Camera, Light, LightKind, Scene};
-use isr::settings::{LightTreeSettings, Method, RenderSettings};
+use isr::settings::{Method, RenderSettings};
 
 fn point(position: Vec3, intensity: f32) -> Light {
     Light {
@@ -71,7 +72,7 @@ fn direct_only(width: u32, rsm: u32) -> RenderSettings {
         width,
         height: width,
         rsm_resolution: rsm,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     }
 }
@@ -218,7 +219,7 @@ fn point_light_in_a_closed_box_reflects_rho_4_pi_i() {
     let (albedo, intensity) = (0.4, 3.0);
     let scene = inward_box(point(Vec3::new(0.2, 0.3, -0.1), intensity), albedo);
     let settings = RenderSettings {
-        method: Method::MultiresGather,
+        method: Method::new("multires-gather"),
         ..direct_only(32, 256)
     };
     let mut r = Renderer::new(&gpu, &scene, &settings).unwrap();
@@ -263,7 +264,7 @@ fn directional_light_reflects_rho_e_times_the_lit_area() {
         let mut scene = floor_scene(sun(direction, e), looking_down(), 1.0, albedo);
         scene.lights[0].direction = direction.normalize();
         let settings = RenderSettings {
-            method: Method::MultiresGather,
+            method: Method::new("multires-gather"),
             ..direct_only(32, 256)
         };
         let mut r = Renderer::new(&gpu, &scene, &settings).unwrap();
@@ -321,31 +322,23 @@ fn box_sun() -> Light {
 fn two_lights_render_as_the_sum_of_each_alone() {
     let gpu = gpu();
     // Every GPU method; the reference in several submissions per light view.
-    let methods = [
-        Method::None,
-        Method::MultiresGather,
-        Method::Isr,
-        Method::Hisr,
-        Method::RsmGather,
-        Method::RsmSplat,
-        Method::RsmSplatRestricted,
-        Method::MultiresSplat,
-        Method::Reference,
-    ];
-    for method in methods {
-        let settings = RenderSettings {
+    for method in isr::methods::REGISTRY.iter().map(|d| d.key()) {
+        let mut settings = RenderSettings {
             width: 48,
             height: 48,
             rsm_resolution: 32,
-            vpls: 64,
             method,
-            reference_chunk: 48 * 48 * 32 * 8,
-            light_tree: LightTreeSettings {
-                isr_base: 16,
-                ..Default::default()
-            },
             ..Default::default()
         };
+        // Only the parameters the method reads.
+        for name in isr::methods::params_of(isr::methods::find(method).unwrap()).map(|p| p.name()) {
+            match name {
+                "vpls" => VPLS.set(&mut settings, 64),
+                "reference-chunk" => reference::CHUNK.set(&mut settings, 48 * 48 * 32 * 8),
+                "isr-base" => BASE.set(&mut settings, 16),
+                _ => {}
+            }
+        }
         let read = |lights| render(&gpu, &cornell_with(lights), &settings, 1).readback;
         let both_run = render(
             &gpu,
@@ -375,7 +368,8 @@ fn two_lights_render_as_the_sum_of_each_alone() {
             let (s, x, y) = (get(&both), get(&a), get(&b));
             let total = |v: &[[f32; 4]]| v.iter().map(|t| t[0] as f64).sum::<f64>();
             assert!(
-                (layer == 1 && method == Method::None) || (total(&x) > 0.0 && total(&y) > 0.0),
+                (layer == 1 && method == Method::new("none"))
+                    || (total(&x) > 0.0 && total(&y) > 0.0),
                 "each light alone lights the box"
             );
             for i in 0..s.len() {
@@ -409,32 +403,26 @@ fn hisr_converges(light: Light) {
     let gpu = gpu();
     let scene = cornell_with(vec![light]);
     let rsm = 32;
-    let base = |method, lt| RenderSettings {
+    let base = |method| RenderSettings {
         width: 48,
         height: 48,
         rsm_resolution: rsm,
         method,
-        light_tree: lt,
         ..Default::default()
     };
     let dense = render(
         &gpu,
         &scene,
-        &RenderSettings {
-            vpls: rsm * rsm,
-            ..base(Method::MultiresGather, LightTreeSettings::default())
-        },
+        &base(Method::new("multires-gather")).with(&VPLS, rsm * rsm),
         1,
     )
     .readback;
     let mut errors = Vec::new();
     for tau in [0.5, 0.05, 0.002, 0.00001] {
-        let lt = LightTreeSettings {
-            tau,
-            max_depth: Some(5), // log2(32): down to single texels
-            ..Default::default()
-        };
-        let out = render(&gpu, &scene, &base(Method::Hisr, lt), 1).readback;
+        let s = base(hisr::KEY)
+            .with(&hisr::TAU, tau)
+            .with(&hisr::MAX_DEPTH, 5); // log2(32): down to single texels
+        let out = render(&gpu, &scene, &s, 1).readback;
         errors.push(relative_rmse(&out, &dense));
     }
     println!("{:?}: relative RMSE over tau {errors:?}", light.kind);
@@ -514,13 +502,10 @@ fn isr_merges_a_flat_floor_under_cube_faces_and_orthographic_rsms() {
     // (a raised square) makes the patches over its edges invalid.
     let gpu = gpu();
     let settings = RenderSettings {
-        method: Method::Isr,
-        light_tree: LightTreeSettings {
-            isr_base: 16,
-            ..Default::default()
-        },
+        method: Method::new("isr"),
         ..direct_only(32, 64)
-    };
+    }
+    .with(&BASE, 16);
     for light in [
         point(Vec3::new(0.3, 1.2, -0.2), 7.0),
         sun(Vec3::new(0.3, -1.0, 0.2), 2.0),

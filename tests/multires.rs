@@ -4,39 +4,34 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::multires::{MultiresSettings, Upsample};
+use isr::methods::vpls::{VplSampling, VPLS, VPL_SAMPLING};
+use isr::multires::{Upsample, DEPTH_THRESHOLD, NORMAL_THRESHOLD, STENCIL, UPSAMPLE};
 use isr::scene::{cornell::cornell_box, Camera, Scene};
 use isr::settings::{Method, RenderSettings};
 
-fn settings(width: u32, height: u32, multires: MultiresSettings) -> RenderSettings {
+/// `multires-gather` with 256 VPLs at `width` x `height`, RSM 256.
+fn settings(width: u32, height: u32) -> RenderSettings {
     RenderSettings {
         width,
         height,
         rsm_resolution: 256,
-        method: Method::MultiresGather,
-        vpls: 256,
-        multires,
+        method: Method::new("multires-gather"),
         ..Default::default()
     }
+    .with(&VPLS, 256)
 }
 
 /// Thresholds of 0: no texel above level 0 is smooth (the tests are strict `<`).
-fn level_zero_only() -> MultiresSettings {
-    MultiresSettings {
-        depth_threshold: 0.0,
-        normal_threshold_deg: 0.0,
-        ..Default::default()
-    }
+fn level_zero_only(width: u32, height: u32) -> RenderSettings {
+    settings(width, height)
+        .with(&DEPTH_THRESHOLD, 0.0)
+        .with(&NORMAL_THRESHOLD, 0.0)
 }
 
 #[test]
 fn stencilled_texels_partition_the_pixels_with_geometry() {
     let gpu = gpu();
-    let out = render_multires(
-        &gpu,
-        &cornell_box(),
-        &settings(256, 192, MultiresSettings::default()),
-    );
+    let out = render_multires(&gpu, &cornell_box(), &settings(256, 192));
     let m = &out.multires;
     let (w, h) = (m.width, m.height);
     let mut per_level = vec![0u32; m.levels as usize + 1];
@@ -94,11 +89,7 @@ fn background_pixels_get_no_patch() {
         60f32.to_radians(),
         0.05,
     );
-    let out = render_multires(
-        &gpu,
-        &scene,
-        &settings(128, 128, MultiresSettings::default()),
-    );
+    let out = render_multires(&gpu, &scene, &settings(128, 128));
     let levels = isr::debug_view::patch_levels(&out.multires);
     let mut background = 0;
     for (i, l) in levels.iter().enumerate() {
@@ -115,11 +106,7 @@ fn background_pixels_get_no_patch() {
 #[test]
 fn refinement_is_two_to_one_balanced() {
     let gpu = gpu();
-    let out = render_multires(
-        &gpu,
-        &cornell_box(),
-        &settings(256, 256, MultiresSettings::default()),
-    );
+    let out = render_multires(&gpu, &cornell_box(), &settings(256, 256));
     let levels = isr::debug_view::patch_levels(&out.multires);
     let w = out.multires.width as usize;
     let mut max_level = 0;
@@ -187,11 +174,7 @@ fn discontinuity_on_a_texel_border_is_not_missed() {
         ],
         m,
     );
-    let out = render_multires(
-        &gpu,
-        &scene,
-        &settings(128, 128, MultiresSettings::default()),
-    );
+    let out = render_multires(&gpu, &scene, &settings(128, 128));
     let rb = &out.readback;
     let depth = |x: u32, y: u32| rb.position[(y * 128 + x) as usize][3];
     assert!(
@@ -221,7 +204,7 @@ fn discontinuity_on_a_texel_border_is_not_missed() {
 #[test]
 fn level_zero_gather_equals_the_cpu_sum() {
     let gpu = gpu();
-    let out = render_multires(&gpu, &cornell_box(), &settings(128, 96, level_zero_only()));
+    let out = render_multires(&gpu, &cornell_box(), &level_zero_only(128, 96));
     let m = &out.multires;
     assert!(
         out.stats.patches_per_level.as_ref().unwrap()[1..]
@@ -229,7 +212,7 @@ fn level_zero_gather_equals_the_cpu_sum() {
             .all(|&c| c == 0),
         "only level 0"
     );
-    let k = out.run.hierarchy[1] as usize;
+    let k = out.run.vpl_level as usize;
     assert_eq!(m.rsm_tree[k][0].len(), 256, "256 VPLs at level {k}");
     let vpls = vpls_at(m, k);
     let mut checked = 0;
@@ -257,13 +240,9 @@ fn rb_len(out: &RenderedMultires) -> usize {
 #[test]
 fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
     let gpu = gpu();
-    let out = render_multires(
-        &gpu,
-        &cornell_box(),
-        &settings(128, 128, MultiresSettings::default()),
-    );
+    let out = render_multires(&gpu, &cornell_box(), &settings(128, 128));
     let m = &out.multires;
-    let vpls = vpls_at(m, out.run.hierarchy[1] as usize);
+    let vpls = vpls_at(m, out.run.vpl_level as usize);
     let w = m.width;
     let mut checked = vec![0; m.levels as usize + 1];
     for (l, count) in checked.iter_mut().enumerate() {
@@ -296,23 +275,8 @@ fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
 fn stencil_off_shades_every_texel_and_gives_the_same_image() {
     let gpu = gpu();
     let scene = cornell_box();
-    let on = render_multires(
-        &gpu,
-        &scene,
-        &settings(128, 128, MultiresSettings::default()),
-    );
-    let off = render_multires(
-        &gpu,
-        &scene,
-        &settings(
-            128,
-            128,
-            MultiresSettings {
-                stencil: false,
-                ..Default::default()
-            },
-        ),
-    );
+    let on = render_multires(&gpu, &scene, &settings(128, 128));
+    let off = render_multires(&gpu, &scene, &settings(128, 128).with(&STENCIL, false));
     let gather = |r: &RenderedMultires| {
         r.stats.frames[0]
             .iter()
@@ -395,21 +359,8 @@ fn interpolated_upsampling_leaves_no_seams_on_a_flat_wall() {
     let gpu = gpu();
     let scene = flat_wall_scene();
     let (w, h) = (128, 128);
-    let reference = render_multires(&gpu, &scene, &settings(w, h, level_zero_only()));
-    let run = |upsample| {
-        render_multires(
-            &gpu,
-            &scene,
-            &settings(
-                w,
-                h,
-                MultiresSettings {
-                    upsample,
-                    ..Default::default()
-                },
-            ),
-        )
-    };
+    let reference = render_multires(&gpu, &scene, &level_zero_only(w, h));
+    let run = |upsample| render_multires(&gpu, &scene, &settings(w, h).with(&UPSAMPLE, upsample));
     let interpolated = run(Upsample::Interpolated);
     let nearest = run(Upsample::Nearest);
     let counts = interpolated.stats.patches_per_level.clone().unwrap();
@@ -447,13 +398,10 @@ fn interpolated_upsampling_leaves_no_seams_on_a_flat_wall() {
 #[test]
 fn point_sampled_vpls_scale_flux_by_the_patch_size() {
     let gpu = gpu();
-    let s = RenderSettings {
-        vpl_sampling: isr::settings::VplSampling::Point,
-        ..settings(64, 64, level_zero_only())
-    };
+    let s = level_zero_only(64, 64).with(&VPL_SAMPLING, VplSampling::Point);
     let out = render_multires(&gpu, &cornell_box(), &s);
     let m = &out.multires;
-    let k = out.run.hierarchy[1] as usize;
+    let k = out.run.vpl_level as usize;
     let span = 1usize << k;
     let r = m.rsm_tree[0][0].len().isqrt();
     // Centre texels of each patch, flux and area scaled by span^2.

@@ -39,14 +39,11 @@ fn a_renderer_failing_at_any_pipeline_frees_everything_it_made() {
         width: 64,
         height: 48,
         rsm_resolution: 32,
-        vpls: 16,
-        method: Method::Isr,
-        light_tree: isr::settings::LightTreeSettings {
-            isr_base: 8,
-            ..Default::default()
-        },
+        method: Method::new("isr"),
         ..Default::default()
-    };
+    }
+    .with(&isr::methods::vpls::VPLS, 16)
+    .with(&isr::methods::isr::BASE, 8);
     // The built-in spot, and a point light with a directional one: the cube
     // RSM (`rsm-cube`) and `light-sum` make pipelines and images of their own.
     let spot = cornell_box();

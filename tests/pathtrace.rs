@@ -62,7 +62,7 @@ fn compare_direct_layers(scene: &Scene) {
             width: w,
             height: h,
             rsm_resolution: 1024,
-            method: Method::None,
+            method: Method::new("none"),
             ..Default::default()
         },
         1,
@@ -202,7 +202,7 @@ fn path_tracer_differs_from_the_vpl_reference_where_the_bounce_is_occluded() {
             width: w,
             height: h,
             rsm_resolution: 64,
-            method: Method::Reference,
+            method: Method::new("reference"),
             ..Default::default()
         },
         1,
@@ -320,7 +320,7 @@ fn single_sided_occluders_shadow_alike_in_both_renderers() {
             &RenderSettings {
                 width: 64,
                 height: 64,
-                method: Method::None,
+                method: Method::new("none"),
                 ..Default::default()
             },
             1,

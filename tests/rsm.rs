@@ -40,7 +40,7 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
         width: 64,
         height: 64,
         rsm_resolution: 256,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     };
     let rsm = render(&gpu, &scene, &settings, 1).readback.rsm;
@@ -165,14 +165,14 @@ fn rsm_quadtree_matches_an_independent_cpu_reduction() {
         width: 64,
         height: 64,
         rsm_resolution: 64,
-        vpls: 16,
-        method: Method::MultiresGather,
+        method: Method::new("multires-gather"),
         ..Default::default()
-    };
+    }
+    .with(&isr::methods::vpls::VPLS, 16);
     let m = render_multires(&gpu, &scene, &settings).multires;
-    let lt = &settings.light_tree;
+    use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
     let light = scene.lights[0].position.as_dvec3();
-    let cos_normal = (lt.normal_threshold_deg as f64).to_radians().cos();
+    let cos_normal = (VALIDITY_NORMAL.get(&settings) as f64).to_radians().cos();
     let v = |a: &[f32; 4]| glam::DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     let [pos, nrm, flux] = &m.rsm_tree[0];
     let mut level: Vec<Node> = (0..pos.len())
@@ -189,7 +189,13 @@ fn rsm_quadtree_matches_an_independent_cpu_reduction() {
     let mut compared = 0;
     let mut invalid = 0;
     for k in 1..m.rsm_tree.len() {
-        level = cpu_level(&level, side, light, lt.depth_threshold as f64, cos_normal);
+        level = cpu_level(
+            &level,
+            side,
+            light,
+            VALIDITY_DEPTH.get(&settings) as f64,
+            cos_normal,
+        );
         side /= 2;
         let [gpos, gnrm, gflux] = &m.rsm_tree[k];
         for (i, cpu) in level.iter().enumerate() {

@@ -14,8 +14,7 @@ fn memory_is_flat_over_300_moving_frames() {
         width: 32,
         height: 32,
         rsm_resolution: 64,
-        vpls: 16,
-        method: Method::Hisr,
+        method: Method::new("hisr"),
         ..Default::default()
     };
     let samples = isr::soak::run(&gpu, &cornell_box(), &settings, 300, 50, |_| {}).unwrap();

@@ -15,7 +15,7 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
         width: 128,
         height: 128,
         rsm_resolution: 128,
-        method: Method::None,
+        method: Method::new("none"),
         ..Default::default()
     };
     let out = render(&gpu, &cornell_box(), &settings, 4);
@@ -68,7 +68,7 @@ fn patches_are_counted_only_in_a_counting_frame_and_match_the_gathered_texels() 
         width: 128,
         height: 128,
         rsm_resolution: 128,
-        method: Method::MultiresGather,
+        method: Method::new("multires-gather"),
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &cornell_box(), &settings).expect("renderer setup");
@@ -208,27 +208,27 @@ fn validation_with_synchronization_checks_is_silent_over_several_frames() {
     let gpu = validating_gpu();
     assert!(gpu.validating());
     for (method, stencil) in [
-        (Method::None, true),
-        (Method::MultiresGather, true),
-        (Method::MultiresGather, false),
-        (Method::Isr, true),
-        (Method::Hisr, true),
-        (Method::RsmGather, true),
-        (Method::RsmSplat, true),
-        (Method::RsmSplatRestricted, true),
-        (Method::MultiresSplat, true),
-        (Method::Reference, true),
+        (Method::new("none"), true),
+        (Method::new("multires-gather"), true),
+        (Method::new("multires-gather"), false),
+        (Method::new("isr"), true),
+        (Method::new("hisr"), true),
+        (Method::new("rsm-gather"), true),
+        (Method::new("rsm-splat"), true),
+        (Method::new("rsm-splat-restricted"), true),
+        (Method::new("multires-splat"), true),
+        (Method::new("reference"), true),
     ] {
-        let mut settings = RenderSettings {
+        let settings = RenderSettings {
             width: 160,
             height: 120,
             rsm_resolution: 128,
             method,
-            // Several submissions for the reference (4 chunks of 4,096 VPLs).
-            reference_chunk: 160 * 120 * 4096,
             ..Default::default()
-        };
-        settings.multires.stencil = stencil;
+        }
+        // Several submissions for the reference (4 chunks of 4,096 VPLs).
+        .with(&isr::methods::reference::CHUNK, 160 * 120 * 4096)
+        .with(&isr::multires::STENCIL, stencil);
         // `render` asserts that no message was reported (frames replay one
         // command buffer, so frame 2 onwards checks the hazards between frames
         // too), and reads every output back.

@@ -29,9 +29,10 @@ pub struct BenchArgs {
     /// paths to .gltf/.glb files. Default: all bench scenes (quick: cornell, slats).
     #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub scenes: Vec<String>,
-    /// Methods to sweep (comma-separated). Default: every method but the references.
-    #[arg(long, value_enum, value_delimiter = ',', num_args = 1..)]
-    pub methods: Vec<Method>,
+    /// Methods to sweep (comma-separated). Default: every method with a sweep
+    /// (all but `none` and the references).
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    pub methods: Vec<String>,
     /// Image width (default 128; quick 64).
     #[arg(long)]
     pub width: Option<u32>,
@@ -56,6 +57,10 @@ pub struct BenchArgs {
     /// Vulkan device index (`isr devices`).
     #[arg(long)]
     pub device: Option<usize>,
+    /// Parameters every point renders with, where its sweep does not set
+    /// them (`--levels 4`: every multiresolution method at 4 levels).
+    #[command(flatten)]
+    pub params: crate::methods::ParamArgs,
 }
 
 impl Default for BenchArgs {
@@ -71,6 +76,7 @@ impl Default for BenchArgs {
             out_dir: "out/bench".into(),
             quick: false,
             device: None,
+            params: Default::default(),
         }
     }
 }
@@ -149,20 +155,23 @@ impl BenchArgs {
                 });
             }
         }
+        let swept = sweep::methods();
         let methods = if self.methods.is_empty() {
-            sweep::METHODS.to_vec()
+            swept
         } else {
-            for m in &self.methods {
-                if !sweep::METHODS.contains(m) {
-                    let valid: Vec<&str> = sweep::METHODS.iter().map(|m| m.name()).collect();
+            let mut chosen = vec![];
+            for name in &self.methods {
+                let m = crate::methods::by_name(name)?.key();
+                if !swept.contains(&m) {
+                    let valid: Vec<&str> = swept.iter().map(|m| m.name()).collect();
                     bail!(
-                        "method '{}' has no sweep (the dense reference renders once per scene and frame by itself); choose from: {}",
-                        m.name(),
+                        "method '{name}' has no sweep (the dense reference renders once per scene and frame by itself); choose from: {}",
                         valid.join(", ")
                     );
                 }
+                chosen.push(m);
             }
-            self.methods.clone()
+            chosen
         };
         let small = if q { 64 } else { 128 };
         let (width, height) = (self.width.unwrap_or(small), self.height.unwrap_or(small));
@@ -185,6 +194,7 @@ impl BenchArgs {
                 width,
                 height,
                 rsm_resolution: rsm,
+                params: self.params.0.clone(),
                 ..RenderSettings::DEFAULT
             },
             frames,
@@ -218,7 +228,7 @@ impl Plan {
     pub fn keys(&self) -> Vec<String> {
         let mut keys = vec![];
         for s in &self.scenes {
-            keys.push(self.key(&s.name, Method::Reference.name(), REFERENCE_LABEL));
+            keys.push(self.key(&s.name, REFERENCE.name(), REFERENCE_LABEL));
             for c in self.configs() {
                 keys.push(self.key(&s.name, c.method.name(), &c.label(&self.base)));
             }
@@ -228,6 +238,7 @@ impl Plan {
 }
 
 const REFERENCE_LABEL: &str = "every RSM texel";
+const REFERENCE: Method = crate::methods::reference::KEY;
 
 /// One frame of the dense reference, what every method is compared with.
 struct RefFrame {
@@ -278,13 +289,7 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
         units += plan.frames as u64 * (todo.len() as u64 + 1);
         pending.push((s.clone(), todo, ref_row));
     }
-    let bar = indicatif::ProgressBar::new(units);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "[{elapsed_precise}] {bar:30} {pos}/{len} frames, {eta} left: {msg}",
-        )
-        .expect("the progress template is valid"),
-    );
+    let bar = crate::progress::bar(units, "frames");
     for (spec, todo, ref_row) in &pending {
         let scene = spec.load()?;
         run_scene(plan, &gpu, spec, &scene, todo, *ref_row, &journal, &bar)?;
@@ -338,10 +343,7 @@ fn run_scene(
     let mut refs = Vec::with_capacity(plan.frames as usize);
     let mut ref_stats = FrameStats::default();
     {
-        let settings = RenderSettings {
-            method: Method::Reference,
-            ..plan.base.clone()
-        };
+        let settings = settings_of(plan, REFERENCE);
         let mut r = Renderer::new(gpu, scene, &settings)?;
         for k in 0..plan.frames {
             bar.set_message(format!(
@@ -372,12 +374,7 @@ fn run_scene(
         }
     }
     if ref_row {
-        let mut row = timing_row(
-            plan,
-            spec,
-            &settings_of(plan, Method::Reference),
-            &ref_stats,
-        );
+        let mut row = timing_row(plan, spec, &settings_of(plan, REFERENCE), &ref_stats);
         row.label = REFERENCE_LABEL.into();
         row.key = plan.key(&spec.name, "reference", REFERENCE_LABEL);
         row.is_default = true;
@@ -385,7 +382,7 @@ fn run_scene(
     }
     // The allocator's total without any indirect method, to subtract.
     let baseline = {
-        let _none = Renderer::new(gpu, scene, &settings_of(plan, Method::None))?;
+        let _none = Renderer::new(gpu, scene, &settings_of(plan, crate::methods::none::KEY))?;
         allocated_bytes(gpu)
     };
     for c in todo {
@@ -494,20 +491,30 @@ fn settings_of(plan: &Plan, method: Method) -> RenderSettings {
 }
 
 /// Light-patch evaluations of the last frame: counted by the multiresolution
-/// gathers (and splats), or pixels with geometry times N for the
-/// full-resolution methods that evaluate every VPL at every pixel.
+/// gathers (and splats), or pixels with geometry times what the method
+/// evaluates per pixel where that is fixed.
 fn light_patch_evals(r: &Renderer, s: &RenderSettings, out: &Readback) -> Result<Option<u64>> {
-    Ok(match s.method {
-        m if m.uses_multires() => r
+    let d = crate::methods::find(s.method)?;
+    if d.uses_multires() {
+        return Ok(r
             .readback_multires()?
             .map(|m| crate::debug_view::light_patch_stats(&m, None).total_evaluations)
-            .filter(|&n| n > 0),
-        Method::RsmGather | Method::RsmSplat => {
-            let pixels = out.position.iter().filter(|p| p[3] > 0.0).count() as u64;
-            Some(pixels * s.vpls as u64)
-        }
-        _ => None,
-    })
+            .filter(|&n| n > 0));
+    }
+    Ok(d.evaluations_per_pixel(s).map(|n| {
+        let pixels = out.position.iter().filter(|p| p[3] > 0.0).count() as u64;
+        pixels * n
+    }))
+}
+
+/// The values of every parameter `s`'s method reads, by name, as text.
+fn parameter_values(s: &RenderSettings) -> std::collections::BTreeMap<String, String> {
+    match crate::methods::find(s.method) {
+        Ok(d) => crate::methods::params_of(d)
+            .map(|p| (p.name().to_string(), p.text_in(s)))
+            .collect(),
+        Err(_) => Default::default(),
+    }
 }
 
 /// A row with the settings and the timings filled in; errors zero.
@@ -537,16 +544,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         method: s.method.name().into(),
         label: String::new(),
         is_default: false,
-        vpls: s
-            .method
-            .uses_regular_vpls()
-            .then_some(s.vpls)
-            .filter(|_| !matches!(s.method, Method::Isr | Method::Hisr)),
-        isr_base: (s.method == Method::Isr).then_some(s.light_tree.isr_base),
-        tau: (s.method == Method::Hisr).then_some(s.light_tree.tau),
-        max_depth: (s.method == Method::Hisr).then_some(s.hisr_max_depth()),
-        depth_threshold: s.multires.depth_threshold,
-        normal_threshold: s.multires.normal_threshold_deg,
+        params: parameter_values(s),
         width: s.width,
         height: s.height,
         rsm: s.rsm_resolution,

@@ -25,8 +25,9 @@ const REGULAR: &[&str] = &[
 ];
 
 fn find<'a>(rows: &'a [Row], scene: &str, method: &str, vpls: u32) -> Option<&'a Row> {
-    rows.iter()
-        .find(|r| r.scene == scene && r.method == method && r.vpls == Some(vpls))
+    rows.iter().find(|r| {
+        r.scene == scene && r.method == method && r.param("vpls") == Some(&vpls.to_string())
+    })
 }
 
 fn ms(r: &Row) -> f64 {
@@ -305,7 +306,9 @@ mod tests {
     fn row(method: &str, vpls: Option<u32>, ms: f64, err: f64, flicker: f64) -> Row {
         let mut r = super::super::rows::tests_support::row("k");
         r.method = method.into();
-        r.vpls = vpls;
+        if let Some(n) = vpls {
+            r.params.insert("vpls".into(), n.to_string());
+        }
         r.indirect_ms = Some(ms);
         r.rel_rmse_indirect = err;
         r.flicker = Some(flicker);

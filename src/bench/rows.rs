@@ -16,13 +16,10 @@ pub struct Row {
     pub method: String,
     pub label: String,
     pub is_default: bool,
-    pub vpls: Option<u32>,
-    pub isr_base: Option<u32>,
-    pub tau: Option<f32>,
-    pub max_depth: Option<u32>,
-    /// Eye-space refinement thresholds (`--depth-threshold`, `--normal-threshold`).
-    pub depth_threshold: f32,
-    pub normal_threshold: f32,
+    /// The value of every parameter the method reads, by option name
+    /// (`vpls`, `tau`, `max-depth`: derived defaults resolved), as text.
+    #[serde(default)]
+    pub params: BTreeMap<String, String>,
     pub width: u32,
     pub height: u32,
     pub rsm: u32,
@@ -102,6 +99,26 @@ fn opt<T: ToString>(v: &Option<T>) -> String {
     v.as_ref().map(T::to_string).unwrap_or_default()
 }
 
+impl Row {
+    /// The value of parameter `name` (`"vpls"`), if the row's method reads it.
+    pub fn param(&self, name: &str) -> Option<&str> {
+        self.params.get(name).map(String::as_str)
+    }
+}
+
+/// The parameter names of all rows, in order of first appearance.
+pub fn param_names(rows: &[Row]) -> Vec<String> {
+    let mut names: Vec<String> = vec![];
+    for r in rows {
+        for n in r.params.keys() {
+            if !names.contains(n) {
+                names.push(n.clone());
+            }
+        }
+    }
+    names
+}
+
 /// The pass names of all rows, in order of first appearance.
 pub fn pass_names(rows: &[Row]) -> Vec<String> {
     let mut names: Vec<String> = vec![];
@@ -115,30 +132,35 @@ pub fn pass_names(rows: &[Row]) -> Vec<String> {
     names
 }
 
-/// `results.csv`: one line per row; empty cells where a value does not apply.
+/// `results.csv`: one line per row, a column per parameter (named as its
+/// option) and per pass; empty cells where a value does not apply.
 pub fn to_csv(rows: &[Row]) -> String {
+    let params = param_names(rows);
     let passes = pass_names(rows);
-    let mut out = String::from(
-        "scene,method,label,is_default,vpls,isr_base,tau,max_depth,depth_threshold,normal_threshold,\
-width,height,rsm,frames,indirect_ms,indirect_ms_min,total_ms,fragment_invocations,light_patch_evals,\
-rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,gpu_memory_bytes",
-    );
+    let mut out = String::from("scene,method,label,is_default");
+    for p in &params {
+        out += &format!(",{p}");
+    }
+    out += ",width,height,rsm,frames,indirect_ms,indirect_ms_min,total_ms,fragment_invocations,\
+light_patch_evals,rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,\
+gpu_memory_bytes";
     for p in &passes {
         out += &format!(",{p}_ms");
     }
     out.push('\n');
     for r in rows {
-        let cells = [
+        let mut cells = vec![
             r.scene.clone(),
             r.method.clone(),
             format!("\"{}\"", r.label),
             r.is_default.to_string(),
-            opt(&r.vpls),
-            opt(&r.isr_base),
-            opt(&r.tau),
-            opt(&r.max_depth),
-            r.depth_threshold.to_string(),
-            r.normal_threshold.to_string(),
+        ];
+        cells.extend(
+            params
+                .iter()
+                .map(|p| r.param(p).unwrap_or_default().to_string()),
+        );
+        cells.extend([
             r.width.to_string(),
             r.height.to_string(),
             r.rsm.to_string(),
@@ -155,7 +177,7 @@ rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,gpu_m
             opt(&r.flicker_second),
             opt(&r.flicker_final),
             opt(&r.gpu_memory_bytes),
-        ];
+        ]);
         out += &cells.join(",");
         for p in &passes {
             out += &format!(",{}", opt(&r.passes.get(p)));
@@ -177,12 +199,10 @@ pub(crate) mod tests_support {
             method: "hisr".into(),
             label: "tau 0.05, depth 6".into(),
             is_default: true,
-            vpls: None,
-            isr_base: None,
-            tau: Some(0.05),
-            max_depth: None,
-            depth_threshold: 0.1,
-            normal_threshold: 20.0,
+            params: [("tau", "0.05"), ("max-depth", "6")]
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
             width: 8,
             height: 8,
             rsm: 8,
@@ -237,7 +257,8 @@ mod tests {
         let csv = to_csv(&[row("a")]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(",gather_ms"));
-        assert!(lines[1].contains(",hisr,\"tau 0.05, depth 6\",true,,,0.05,,"));
+        assert!(lines[0].starts_with("scene,method,label,is_default,max-depth,tau,width,"));
+        assert!(lines[1].contains(",hisr,\"tau 0.05, depth 6\",true,6,0.05,8,"));
         assert!(lines[1].ends_with(",1"));
     }
 }

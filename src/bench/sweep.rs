@@ -1,185 +1,72 @@
-//! Each method's parameter sweep (docs/algorithm.md section 6.5): VPL counts
-//! for the regular methods, the base level for Basic ISR, tau, max depth and
-//! the eye-space refinement threshold for HISR. One point of each sweep is the
-//! method's default (`RenderSettings::DEFAULT`), used by the gallery and the
-//! per-pass chart.
+//! The points the bench renders (docs/algorithm.md section 6.5): every
+//! method's own sweep (`methods::Descriptor::sweep`: VPL counts for the
+//! regular methods, the base level for Basic ISR, tau, max depth and the
+//! eye-space refinement threshold for HISR). One point of each sweep is the
+//! method's default, used by the gallery and the per-pass chart.
 
-use crate::settings::{Method, RenderSettings};
+use crate::methods::{self, Descriptor};
+use crate::settings::{Method, Params, RenderSettings};
 
-/// The methods the bench sweeps, in report order.
-pub const METHODS: &[Method] = &[
-    Method::RsmGather,
-    Method::RsmSplat,
-    Method::RsmSplatRestricted,
-    Method::MultiresSplat,
-    Method::MultiresGather,
-    Method::Isr,
-    Method::Hisr,
-];
+/// The methods the bench sweeps, in report order: every registered method
+/// with a sweep.
+pub fn methods() -> Vec<Method> {
+    methods::REGISTRY
+        .iter()
+        .filter(|d| {
+            !d.sweep(RenderSettings::DEFAULT.rsm_resolution, true)
+                .is_empty()
+        })
+        .map(|d| d.key())
+        .collect()
+}
 
-/// One point of a sweep: the method and what it changes from the defaults.
+/// One point of a sweep: the method and the parameter values it sets.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     pub method: Method,
-    pub vpls: Option<u32>,
-    pub isr_base: Option<u32>,
-    pub tau: Option<f32>,
-    pub max_depth: Option<u32>,
-    /// Eye-space refinement: `MultiresSettings::depth_threshold`.
-    pub depth_threshold: Option<f32>,
+    pub params: Params,
 }
 
 impl Config {
-    fn new(method: Method) -> Self {
-        Self {
-            method,
-            vpls: None,
-            isr_base: None,
-            tau: None,
-            max_depth: None,
-            depth_threshold: None,
-        }
+    fn descriptor(&self) -> &'static dyn Descriptor {
+        methods::find(self.method).expect("a sweep point names a registered method")
     }
 
-    /// The settings this point renders with.
+    /// The settings this point renders with: `base`'s, with this point's
+    /// values over them.
     pub fn settings(&self, base: &RenderSettings) -> RenderSettings {
-        let mut s = base.clone();
-        s.method = self.method;
-        if let Some(v) = self.vpls {
-            s.vpls = v;
-        }
-        if let Some(b) = self.isr_base {
-            s.light_tree.isr_base = b;
-        }
-        if let Some(t) = self.tau {
-            s.light_tree.tau = t;
-        }
-        if self.max_depth.is_some() {
-            s.light_tree.max_depth = self.max_depth;
-        }
-        if let Some(d) = self.depth_threshold {
-            s.multires.depth_threshold = d;
-        }
+        let mut s = base.clone().with_method(self.method);
+        s.params.overlay(&self.params);
         s
     }
 
-    /// Whether this point renders with the method's default settings.
+    /// Whether this point renders with the values `base` gives the method's
+    /// parameters (the method's defaults, unless the run set some).
     pub fn is_default(&self, base: &RenderSettings) -> bool {
-        let d = RenderSettings {
-            method: self.method,
-            ..base.clone()
-        };
-        let mut s = self.settings(base);
-        // An explicit max depth equal to the derived default is the default.
-        if s.light_tree.max_depth == Some(d.hisr_max_depth()) {
-            s.light_tree.max_depth = None;
-        }
-        s.vpls == RenderSettings::DEFAULT.vpls
-            && s.light_tree == RenderSettings::DEFAULT.light_tree
-            && s.multires == RenderSettings::DEFAULT.multires
+        let d = self.descriptor();
+        methods::same_params(
+            d,
+            &self.settings(base),
+            &base.clone().with_method(self.method),
+        )
     }
 
     /// A short label for tables and charts: "256 VPLs", "base 64", "tau 0.05".
     pub fn label(&self, base: &RenderSettings) -> String {
-        let s = self.settings(base);
-        match self.method {
-            Method::Isr => format!("base {}", s.light_tree.isr_base),
-            Method::Hisr => {
-                let mut l = format!("tau {}, depth {}", s.light_tree.tau, s.hisr_max_depth());
-                if s.multires.depth_threshold != RenderSettings::DEFAULT.multires.depth_threshold {
-                    l += &format!(", eye depth {}", s.multires.depth_threshold);
-                }
-                l
-            }
-            _ => format!("{} VPLs", s.vpls),
-        }
+        self.descriptor().label(&self.settings(base))
     }
 }
 
-/// The sweep of `method` for RSM resolution `rsm` (VPL counts and bases are
-/// capped by what the RSM holds); `quick` keeps two or three points.
+/// The sweep of `method` for RSM resolution `rsm`; `quick` keeps two or three points.
 pub fn sweep(method: Method, rsm: u32, quick: bool) -> Vec<Config> {
-    let c = || Config::new(method);
-    let mut out: Vec<Config> = match method {
-        Method::Isr => {
-            let bases: &[u32] = if quick { &[16, 64] } else { &[16, 32, 64] };
-            bases
-                .iter()
-                .filter(|&&b| b <= rsm)
-                .map(|&b| Config {
-                    isr_base: Some(b),
-                    ..c()
-                })
-                .collect()
-        }
-        Method::Hisr => {
-            // Large taus trace the cheap end of HISR's front (at tau 0.97
-            // a valid patch splits only for receivers very near it, while
-            // invalid ones are still held to tau / 100); smaller max depths
-            // at the two largest taus go cheaper still.
-            let taus: &[f32] = if quick {
-                &[0.2, 0.05]
-            } else {
-                &[0.97, 0.94, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
-            };
-            let mut v: Vec<Config> = taus
-                .iter()
-                .map(|&t| Config {
-                    tau: Some(t),
-                    ..c()
-                })
-                .collect();
-            if !quick {
-                let deepest = 6.min(rsm.ilog2());
-                for t in [0.97, 0.9] {
-                    for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
-                        if d >= RenderSettings::DEFAULT.light_tree.start_level {
-                            v.push(Config {
-                                tau: Some(t),
-                                max_depth: Some(d),
-                                ..c()
-                            });
-                        }
-                    }
-                }
-                for t in [0.05, 0.3] {
-                    v.push(Config {
-                        depth_threshold: Some(t),
-                        ..c()
-                    });
-                }
-                // The accurate end: one level deeper (single RSM texels at
-                // RSM 128), where the default depth stops near the error of
-                // 4^6 = 4096 VPLs.
-                if rsm.ilog2() > deepest {
-                    for t in [0.2, 0.1, 0.05, 0.01] {
-                        v.push(Config {
-                            tau: Some(t),
-                            max_depth: Some(deepest + 1),
-                            ..c()
-                        });
-                    }
-                }
-            }
-            v
-        }
-        Method::None | Method::Reference | Method::Pathtrace => vec![],
-        _ => {
-            let counts: &[u32] = if quick {
-                &[64, 256]
-            } else {
-                &[64, 256, 1024, 4096]
-            };
-            counts
-                .iter()
-                .filter(|&&n| n <= rsm * rsm)
-                .map(|&n| Config {
-                    vpls: Some(n),
-                    ..c()
-                })
-                .collect()
-        }
+    let Ok(d) = methods::find(method) else {
+        return vec![];
     };
+    let mut out: Vec<Config> = d
+        .sweep(rsm, quick)
+        .into_iter()
+        .map(|params| Config { method, params })
+        .collect();
     out.dedup();
     out
 }
@@ -189,28 +76,34 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_method_has_its_default_in_its_sweep() {
+    fn every_swept_method_has_its_default_in_its_sweep() {
         let base = RenderSettings {
             rsm_resolution: 128,
             ..RenderSettings::DEFAULT
         };
+        let all = methods();
+        assert_eq!(all.len(), 7, "{all:?}");
         for quick in [false, true] {
-            for &m in METHODS {
+            for &m in &all {
                 let s = sweep(m, 128, quick);
                 assert!(!s.is_empty());
                 let defaults = s.iter().filter(|c| c.is_default(&base)).count();
                 assert_eq!(defaults, 1, "{} quick={quick}", m.name());
             }
         }
-        assert!(sweep(Method::Reference, 128, false).is_empty());
+        assert!(sweep(crate::methods::reference::KEY, 128, false).is_empty());
     }
 
     #[test]
-    fn counts_are_capped_by_the_rsm() {
-        let s = sweep(Method::RsmGather, 16, false);
-        assert_eq!(
-            s.iter().map(|c| c.vpls.unwrap()).collect::<Vec<_>>(),
-            [64, 256]
-        );
+    fn labels_name_the_swept_value() {
+        let base = RenderSettings {
+            rsm_resolution: 128,
+            ..RenderSettings::DEFAULT
+        };
+        let labels: Vec<String> = sweep(crate::methods::hisr::KEY, 128, true)
+            .iter()
+            .map(|c| c.label(&base))
+            .collect();
+        assert_eq!(labels, ["tau 0.2, depth 6", "tau 0.05, depth 6"]);
     }
 }

@@ -3,15 +3,14 @@
 
 use crate::output::OutputKind;
 use crate::renderer::Renderer;
-use crate::settings::{
-    LightTreeSettings, Method, MultiresSettings, RenderSettings, Upsample, VplSampling,
-};
-use crate::vk::{Gpu, GpuOptions, Validation};
+use crate::vk::Gpu;
 use crate::{output, report, scene};
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand};
+use options::{MethodArg, RunArgs};
 use std::path::PathBuf;
 
+mod options;
 mod runs;
 mod view;
 use runs::*;
@@ -48,31 +47,10 @@ enum Command {
     },
 }
 
-/// Every default below comes from `RenderSettings::DEFAULT`, which the
-/// library and the benchmarks use too.
-const D: RenderSettings = RenderSettings::DEFAULT;
-
 #[derive(Args)]
 struct RenderArgs {
-    /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
-    #[arg(long)]
-    scene: Option<PathBuf>,
-    /// Let the scene's buffer and image URIs name files outside its folder
-    /// (absolute paths, '..', file: URIs, symbolic links out of it).
-    #[arg(long)]
-    allow_outside_uris: bool,
-    /// How indirect light is computed.
-    #[arg(long, value_enum, default_value_t = D.method)]
-    method: Method,
-    /// Output width in pixels.
-    #[arg(long, default_value_t = D.width)]
-    width: u32,
-    /// Output height in pixels.
-    #[arg(long, default_value_t = D.height)]
-    height: u32,
-    /// Reflective shadow map resolution R (R x R, a power of two).
-    #[arg(long, default_value_t = D.rsm_resolution)]
-    rsm: u32,
+    #[command(flatten)]
+    run: RunArgs,
     /// Frames to render; timings are medians over them (over all but the last,
     /// which alone counts fragments and invocations, when there are several).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000))]
@@ -86,95 +64,20 @@ struct RenderArgs {
     /// Write per-pass GPU timings as JSON to this file.
     #[arg(long)]
     timings: Option<PathBuf>,
-    /// Multiplier on radiance before the PNG's sRGB encoding.
-    #[arg(long, default_value_t = D.exposure)]
-    exposure: f32,
-    /// Load the Khronos validation layer with synchronization validation; exit
-    /// non-zero if it reports anything.
-    #[arg(long)]
-    validate: bool,
-    /// Device index from `isr devices` (default: discrete > integrated > virtual > CPU).
-    #[arg(long)]
-    device: Option<usize>,
-    /// Regular VPLs (a power of 4): the sqrt(N) x sqrt(N) level of the RSM quadtree.
-    #[arg(long, default_value_t = D.vpls)]
-    vpls: u32,
-    /// A VPL is its patch's mean, or the patch's centre texel with scaled flux.
-    #[arg(long, value_enum, default_value_t = D.vpl_sampling)]
-    vpl_sampling: VplSampling,
-    /// Coarsest level L of the multiresolution buffer (texels of 2^L x 2^L
-    /// pixels); default: about 1/16 of the shorter side (5 at 512).
-    #[arg(long)]
-    levels: Option<u32>,
-    /// Split a texel when its view-depth range relative to its nearest depth,
-    /// (max - min) / min, is not below this.
-    #[arg(long, default_value_t = D.multires.depth_threshold)]
-    depth_threshold: f32,
-    /// Split a texel when its normals span this angle (degrees) or more.
-    #[arg(long, default_value_t = D.multires.normal_threshold_deg)]
-    normal_threshold: f32,
-    /// Upsampling of the multiresolution buffer to full resolution.
-    #[arg(long, value_enum, default_value_t = D.multires.upsample)]
-    upsample: Upsample,
-    /// Early stencil rejection in the gather; `off` shades every texel of every
-    /// level and masks afterwards (to measure what the stencil saves).
-    #[arg(long, value_enum, default_value_t = if D.multires.stencil { OnOff::On } else { OnOff::Off })]
-    stencil: OnOff,
     /// Print patch counts per level (also recorded in the timings JSON).
     #[arg(long)]
     stats: bool,
-    /// Basic ISR's dense starting level, in patches per side (a power of 2).
-    #[arg(long, default_value_t = D.light_tree.isr_base)]
-    isr_base: u32,
-    /// HISR starts its traversal from 2^s x 2^s light patches.
-    #[arg(long, default_value_t = D.light_tree.start_level)]
-    start_level: u32,
-    /// HISR subdivides at most down to 2^d x 2^d patches (at most log2 of
-    /// --rsm; default 6, or log2 of --rsm if smaller); patches spanning a
-    /// discontinuity are held to 1/100 of tau.
-    #[arg(long)]
-    max_depth: Option<u32>,
-    /// HISR's error threshold, as a fraction of the light's peak intensity: a
-    /// light patch is subdivided while its contribution could exceed tau * I.
-    #[arg(long, default_value_t = D.light_tree.tau)]
-    tau: f32,
-    /// HISR finds the traversal shared by each tile of 2^K, 2^(K+1) and
-    /// 2^(K+2) pixels a side once per tile (pass hisr-cut); 0 traverses from
-    /// the roots in every fragment.
-    /// Same image either way (up to float rounding).
-    #[arg(long, default_value_t = D.light_tree.hisr_tile_level)]
-    hisr_tile_level: u32,
-    /// Light patches merge only when each child lies within this fraction of
-    /// its distance to the light from the merged patch's plane.
-    #[arg(long, default_value_t = D.light_tree.depth_threshold)]
-    light_depth_threshold: f32,
-    /// ... and their normals by less than this angle (degrees).
-    #[arg(long, default_value_t = D.light_tree.normal_threshold_deg)]
-    light_normal_threshold: f32,
-    /// --method reference: light-patch evaluations per submission (pixels x
-    /// VPLs). The default keeps a submission near half a second on lavapipe;
-    /// on a GPU, larger chunks cut the per-submission overhead.
-    #[arg(long, default_value_t = D.reference_chunk)]
-    reference_chunk: u64,
     /// Indirect samples per pixel for --method pathtrace.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
     spp: u32,
     /// Random seed for --method pathtrace.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Restricted splats: a VPL's quad covers only where its irradiance bound
-    /// Phi / (pi d^2) exceeds this (W/m^2); 0 gives full-screen splats.
-    #[arg(long, default_value_t = D.splat_threshold)]
-    splat_threshold: f32,
     /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
     /// patch, `indirect` shows the indirect light alone, `vpl-count` is a heat
     /// map of the light patches evaluated per pixel. Repeatable.
     #[arg(long, value_enum)]
     debug_view: Vec<DebugView>,
-    /// Animation time in seconds: the scene's glTF animations (and the
-    /// --orbit-* motion) at this time. With --sequence, the first frame's time.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    time: f32,
     /// Write --frames frames at times --time + k / --fps into this folder
     /// (frame_0000.exr, frame_0000.png, ..., timings.json) instead of timing
     /// one frame --frames times.
@@ -222,10 +125,10 @@ impl RenderArgs {
                 device: &gpu.info.name,
                 driver: &gpu.info.driver,
                 scene: &scene.name,
-                width: self.width,
-                height: self.height,
-                rsm: self.rsm,
-                method: self.method.name(),
+                width: self.run.width,
+                height: self.run.height,
+                rsm: self.run.rsm,
+                method: self.run.method.name(),
             },
             stats,
         )
@@ -247,12 +150,7 @@ impl RenderArgs {
     }
 
     fn check_motion(&self) -> Result<()> {
-        if !self.time.is_finite() {
-            bail!(
-                "--time {}: the animation time must be a finite number of seconds",
-                self.time
-            );
-        }
+        self.run.check_time()?;
         if !(self.fps.is_finite() && self.fps > 0.0) {
             bail!("--fps {}: frames per second must be positive", self.fps);
         }
@@ -270,52 +168,11 @@ impl RenderArgs {
     }
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum OnOff {
-    On,
-    Off,
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum DebugView {
     Levels,
     Indirect,
     VplCount,
-}
-
-/// A one-line progress bar (redrawn in place): frames, and the submissions of
-/// the current frame when there are several (the reference's chunks), with
-/// the time left estimated from the time so far.
-fn progress_line(p: &crate::renderer::FrameProgress, elapsed: f64) -> String {
-    let total = (p.frames * p.submissions) as f64;
-    // A frame's completion is reported with submission 0, the parts of a
-    // multi-submission frame with 1..submissions.
-    let done = if p.frame >= p.frames {
-        total
-    } else {
-        ((p.frame * p.submissions) + p.submission) as f64
-    };
-    let fraction = (done / total).clamp(0.0, 1.0);
-    let width = 30;
-    let filled = (fraction * width as f64).round() as usize;
-    let left = if fraction > 0.0 {
-        elapsed / fraction - elapsed
-    } else {
-        0.0
-    };
-    let part = if p.submissions > 1 {
-        format!(", part {}/{}", p.submission, p.submissions)
-    } else {
-        String::new()
-    };
-    format!(
-        "\r[{}{}] {:>3.0}% frame {}/{}{part}, {left:.0} s left ",
-        "#".repeat(filled),
-        "-".repeat(width - filled),
-        fraction * 100.0,
-        (p.frame + 1).min(p.frames),
-        p.frames
-    )
 }
 
 /// Parses `std::env::args` and runs the command.
@@ -361,15 +218,26 @@ fn devices() -> Result<()> {
 
 fn render(args: RenderArgs) -> Result<()> {
     args.check_motion()?;
+    let run = &args.run;
+    let gpu_method = match run.method {
+        MethodArg::Gpu(m) => Some(crate::methods::find(m)?),
+        MethodArg::PathTrace => None,
+    };
     let needs_multires = args
         .debug_view
         .iter()
         .any(|v| matches!(v, DebugView::Levels | DebugView::VplCount));
-    if needs_multires && !args.method.uses_multires() {
+    if needs_multires && !gpu_method.is_some_and(|d| d.uses_multires()) {
+        let with: Vec<&str> = crate::methods::REGISTRY
+            .iter()
+            .filter(|d| d.uses_multires())
+            .map(|d| d.key().name())
+            .collect();
         bail!(
             "--debug-view levels and vpl-count need a method with the multiresolution buffer \
-             (multires-gather, multires-splat, isr, hisr); --method {} has none",
-            args.method.name()
+             ({}); --method {} has none",
+            with.join(", "),
+            run.method.name()
         );
     }
     let debug_pngs: Vec<PathBuf> = args
@@ -392,22 +260,13 @@ fn render(args: RenderArgs) -> Result<()> {
     } else if let Some(dir) = &args.sequence {
         output::check_sequence_dir(dir)?;
     }
-    let scene = match &args.scene {
-        Some(path) => scene::gltf_load::load_with(
-            path,
-            &scene::gltf_load::LoadOptions {
-                allow_outside_uris: args.allow_outside_uris,
-                ..Default::default()
-            },
-        )?,
-        None => scene::cornell::cornell_box(),
-    };
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-    if args.method == Method::Pathtrace {
+    let scene = run.load_scene()?;
+    let Some(descriptor) = gpu_method else {
+        for name in run.params.0 .0.keys() {
+            eprintln!("warning: --method pathtrace does not read --{name}; it has no effect");
+        }
         // The CPU reference renders the scene posed at --time.
-        let state = args.state_at(&scene, args.time);
+        let state = args.state_at(&scene, run.time);
         let mut posed = scene.clone();
         posed.camera = state.camera;
         posed.lights = state.lights;
@@ -415,7 +274,7 @@ fn render(args: RenderArgs) -> Result<()> {
             inst.world_from_object = *m;
         }
         return pathtrace(&args, &posed);
-    }
+    };
     if scene
         .lights
         .iter()
@@ -423,76 +282,61 @@ fn render(args: RenderArgs) -> Result<()> {
     {
         eprintln!("warning: the spot cone is wider than the RSM's 80 degree half-angle; light beyond it is cut");
     }
-    let gpu = Gpu::new(&GpuOptions {
-        validation: if args.validate {
-            Validation::Required
-        } else {
-            Validation::Off
-        },
-        device_index: args.device,
-    })?;
-    let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
-        rsm_resolution: args.rsm,
-        method: args.method,
-        exposure: args.exposure,
-        vpls: args.vpls,
-        vpl_sampling: args.vpl_sampling,
-        multires: MultiresSettings {
-            levels: args.levels,
-            depth_threshold: args.depth_threshold,
-            normal_threshold_deg: args.normal_threshold,
-            upsample: args.upsample,
-            stencil: args.stencil == OnOff::On,
-        },
-        light_tree: LightTreeSettings {
-            depth_threshold: args.light_depth_threshold,
-            normal_threshold_deg: args.light_normal_threshold,
-            isr_base: args.isr_base,
-            start_level: args.start_level,
-            max_depth: args.max_depth,
-            tau: args.tau,
-            hisr_tile_level: args.hisr_tile_level,
-        },
-        splat_threshold: args.splat_threshold,
-        reference_chunk: args.reference_chunk,
-        ..RenderSettings::default()
-    };
+    let settings = run.settings(descriptor.key());
+    // The settings' own checks need no device: they fail before it starts.
+    crate::frame::check::check_ranges(&settings)?;
+    crate::methods::check(&settings)?;
+    let gpu = Gpu::new(&run.gpu_options())?;
     eprintln!(
         "rendering {} ({} triangles) at {}x{}, rsm {}, method {} on {}",
         scene.name,
         scene.triangle_count(),
-        args.width,
-        args.height,
-        args.rsm,
-        args.method.name(),
+        run.width,
+        run.height,
+        run.rsm,
+        run.method.name(),
         gpu.info.name
     );
     let mut renderer = Renderer::new(&gpu, &scene, &settings)?;
     if let Some(dir) = &args.sequence {
         return sequence(&args, &scene, &gpu, &mut renderer, dir);
     }
-    renderer.update(&args.state_at(&scene, args.time))?;
+    renderer.update(&args.state_at(&scene, run.time))?;
     let frames = args.frames;
-    let started = std::time::Instant::now();
-    let mut line_open = false;
+    let mut bar: Option<indicatif::ProgressBar> = None;
+    let mut finished = 0;
     let stats = renderer
         .render_frames(frames, |p| {
-            if frames > 1 || p.submissions > 1 {
-                eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
-                line_open = p.frame < p.frames;
-                if !line_open {
-                    eprintln!();
-                }
+            finished = p.frame;
+            if frames == 1 && p.submissions == 1 {
+                return;
             }
+            let bar = bar.get_or_insert_with(|| {
+                crate::progress::bar((p.frames * p.submissions) as u64, "parts")
+            });
+            // A frame's completion is reported with submission 0, the parts
+            // of a multi-submission frame with 1..submissions.
+            bar.set_position((p.frame * p.submissions + p.submission) as u64);
+            let part = match p.submissions {
+                1 => String::new(),
+                n => format!(", part {}/{n}", p.submission),
+            };
+            bar.set_message(format!(
+                "frame {}/{}{part}",
+                (p.frame + 1).min(p.frames),
+                p.frames
+            ));
         })
         .map_err(|e| {
-            if line_open {
-                eprintln!();
-            }
-            e.context("rendering failed; no output was written (existing files are untouched)")
-        })?;
+            e.context(format!(
+                "rendering failed after {finished} of {frames} frames; no output was written \
+                 (existing files are untouched)"
+            ))
+        });
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let stats = stats?;
     let result = renderer.readback()?;
     // For --stats, the debug views and the timings JSON's light-patch numbers.
     let multires = renderer.readback_multires()?;
@@ -537,7 +381,7 @@ fn render(args: RenderArgs) -> Result<()> {
             }
             _ => println!(
                 "--stats: method {} has no multiresolution patches",
-                args.method.name()
+                run.method.name()
             ),
         }
     }
@@ -554,12 +398,12 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     if args.debug_view.contains(&DebugView::Indirect) {
         let path = args.debug_view_path(DebugView::Indirect);
-        let rgba = crate::debug_view::indirect_png(&result, args.exposure);
+        let rgba = crate::debug_view::indirect_png(&result, run.exposure);
         output::write_png(&path, result.width, result.height, &rgba)?;
         println!(
             "wrote {} (indirect light alone: albedo/pi * E, exposure {})",
             path.display(),
-            args.exposure
+            run.exposure
         );
     }
 

@@ -5,11 +5,12 @@ use super::*;
 
 /// `--method pathtrace`: the CPU reference, with a progress bar.
 pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
-    if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
+    let run = &args.run;
+    if run.width == 0 || run.height == 0 || run.width > 16384 || run.height > 16384 {
         bail!(
             "resolution {}x{}: width and height must be within 1..=16384",
-            args.width,
-            args.height
+            run.width,
+            run.height
         );
     }
     if args.spp == 0 {
@@ -20,38 +21,24 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
         "path tracing {} ({} triangles) at {}x{}, {} spp, on {threads} CPU threads",
         scene.name,
         scene.triangle_count(),
-        args.width,
-        args.height,
+        run.width,
+        run.height,
         args.spp
     );
     let started = std::time::Instant::now();
+    let bar = crate::progress::bar(run.height as u64, "rows");
     let result = crate::pathtrace::render(
         scene,
         &crate::pathtrace::PathTraceSettings {
-            width: args.width,
-            height: args.height,
+            width: run.width,
+            height: run.height,
             spp: args.spp,
             seed: args.seed,
-            exposure: args.exposure,
+            exposure: run.exposure,
         },
-        |done, rows| {
-            let fraction = done as f64 / rows as f64;
-            let elapsed = started.elapsed().as_secs_f64();
-            let left = if fraction > 0.0 {
-                elapsed / fraction - elapsed
-            } else {
-                0.0
-            };
-            let filled = (fraction * 30.0).round() as usize;
-            eprint!(
-                "\r[{}{}] {:>3.0}% rows {done}/{rows}, {left:.0} s left ",
-                "#".repeat(filled),
-                "-".repeat(30 - filled),
-                fraction * 100.0
-            );
-        },
+        |done, _rows| bar.set_position(done as u64),
     );
-    eprintln!();
+    bar.finish_and_clear();
     let ms = started.elapsed().as_secs_f64() * 1e3;
     println!("pathtrace: {ms:.1} ms on {threads} CPU threads");
     if let Some(path) = &args.timings {
@@ -59,10 +46,10 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
             device: format!("CPU ({threads} threads)"),
             driver: "isr::pathtrace".into(),
             scene: scene.name.clone(),
-            width: args.width,
-            height: args.height,
+            width: run.width,
+            height: run.height,
             rsm: 0,
-            method: Method::Pathtrace.name().into(),
+            method: crate::pathtrace::NAME.into(),
             frames: 1,
             passes: vec![],
             total_gpu_ms_median: None,
@@ -94,33 +81,32 @@ pub(super) fn sequence(
     dir: &std::path::Path,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let started = std::time::Instant::now();
+    let (width, height) = (args.run.width, args.run.height);
     let mut reports = Vec::new();
     let mut gif_frames = Vec::new();
     if args.gif {
         // The frames are kept for the GIF: refuse a length that cannot fit.
-        let bytes = args.frames as u64 * args.width as u64 * args.height as u64 * 4;
+        let bytes = args.frames as u64 * width as u64 * height as u64 * 4;
         if bytes > MAX_GIF_BYTES {
             bail!(
                 "--gif: {} frames of {}x{} need {} MiB in memory (the limit is {} MiB); \
                  render fewer or smaller frames",
                 args.frames,
-                args.width,
-                args.height,
+                width,
+                height,
                 bytes >> 20,
                 MAX_GIF_BYTES >> 20
             );
         }
     }
+    let bar = crate::progress::bar(args.frames as u64, "frames");
     for k in 0..args.frames {
-        let t = args.time + k as f32 / args.fps;
+        let t = args.run.time + k as f32 / args.fps;
         renderer.update(&args.state_at(scene, t))?;
         // Each frame is its own run of one frame: its images are read back
         // before the next one changes the scene.
         let stats = renderer.render_frames(1, |_| {}).map_err(|e| {
-            if k > 0 {
-                eprintln!();
-            }
+            bar.abandon();
             e.context(format!(
                 "rendering frame {k} (t = {t} s) failed; {}timings.json was not written",
                 if k > 0 {
@@ -145,15 +131,9 @@ pub(super) fn sequence(
         let mut r = args.report(gpu, scene, &stats);
         r.time = Some(t);
         reports.push(r);
-        let p = crate::renderer::FrameProgress {
-            frame: k + 1,
-            frames: args.frames,
-            submission: 1,
-            submissions: 1,
-        };
-        eprint!("{}", progress_line(&p, started.elapsed().as_secs_f64()));
+        bar.inc(1);
     }
-    eprintln!();
+    bar.finish_and_clear();
     let path = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": reports }))?;
     output::write_text(&path, &text)?;
@@ -165,7 +145,7 @@ pub(super) fn sequence(
     );
     if args.gif {
         let gif = dir.join("sequence.gif");
-        output::write_gif(&gif, args.width, args.height, gif_frames, args.fps)?;
+        output::write_gif(&gif, width, height, gif_frames, args.fps)?;
         println!("wrote {}", gif.display());
     }
     gpu.validation_verdict()

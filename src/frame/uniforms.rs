@@ -4,7 +4,7 @@
 
 use crate::gpu_types::{self, FrameUniforms, InstanceTransform, RunUniforms};
 use crate::scene::{FrameState, LightKind};
-use crate::settings::{RenderSettings, VplSampling};
+use crate::settings::RenderSettings;
 use crate::view::{self, LightView};
 
 /// What the shaders need of `state` for an image of `s.width` x `s.height`,
@@ -27,14 +27,22 @@ pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, v: &LightView) -> 
     FrameUniforms {
         camera_view_proj: view::camera_view_proj(cam, s.width, s.height).to_cols_array_2d(),
         light_view_proj: v.view_proj.to_cols_array_2d(),
-        camera_position: cam.position().extend(1.0).to_array(),
-        camera_forward: cam.forward().extend(0.0).to_array(),
-        light_position: v.position.extend(range).to_array(),
-        light_direction: v.direction.extend(0.0).to_array(),
-        light_intensity: intensity.extend(intensity.max_element()).to_array(),
-        light_cone: [scale, offset, v.half_extent, v.depth_range],
-        light_kind: [kind, v.face.unwrap_or(0) as i32, v.light as i32, 0],
+        camera_position: cam.position().to_array(),
+        camera_forward: cam.forward().to_array(),
+        light_position: v.position.to_array(),
+        light_range: range,
+        light_direction: v.direction.to_array(),
+        light_kind: kind,
+        light_intensity: intensity.to_array(),
+        light_peak: intensity.max_element(),
+        cone_scale: scale,
+        cone_offset: offset,
+        rsm_half_extent: v.half_extent,
+        rsm_depth_range: v.depth_range,
+        cube_face: v.face.unwrap_or(0) as i32,
+        light_index: v.light as i32,
         cube_view_proj: v.cube.map(|m| m.to_cols_array_2d()),
+        ..Default::default()
     }
 }
 
@@ -47,42 +55,20 @@ pub fn instance_transforms(state: &FrameState) -> Vec<InstanceTransform> {
         .collect()
 }
 
-/// What stays fixed for a run of `s`.
+/// What stays fixed for a run of `s`, as far as every run shares it: the
+/// shadow constants and the sizes. The other fields belong to the modules
+/// that own their parameters (the RSM tree's validity, the method's), which
+/// write them after this.
 pub fn run_uniforms(s: &RenderSettings) -> RunUniforms {
-    let side = ((s.effective_vpls() as f64).sqrt() as u32).max(1);
-    let vpl_level = s.rsm_resolution.max(side).ilog2() - side.ilog2();
-    let mut flags = 0;
-    if s.vpl_sampling == VplSampling::Point {
-        flags |= gpu_types::HIERARCHY_POINT_VPLS;
-    }
-    if !s.multires.stencil {
-        flags |= gpu_types::HIERARCHY_STENCIL_OFF;
-    }
-    let chord = 2.0 * (0.5 * s.multires.normal_threshold_deg.to_radians()).sin();
-    let lt = &s.light_tree;
     RunUniforms {
-        shadow: [
-            s.shadow_normal_offset,
-            s.shadow_depth_bias,
-            s.pcf_radius,
-            s.shadow_slope_bias,
-        ],
-        exposure: [s.exposure, 0.0, 0.0, 0.0],
-        size: [s.width, s.height, s.rsm_resolution, 0],
-        refine: [s.multires.depth_threshold, chord, 0.0, 0.0],
-        hierarchy: [s.levels() as i32, vpl_level as i32, side as i32, flags],
-        light_tree: [
-            crate::methods::hisr::subdivision_threshold(lt.tau, s.rsm_resolution),
-            lt.depth_threshold,
-            lt.normal_threshold_deg.to_radians().cos(),
-            0.0,
-        ],
-        splat: [s.splat_threshold, 0.0, 0.0, 0.0],
-        light_levels: [
-            lt.start_level as i32,
-            s.hisr_max_depth() as i32,
-            s.isr_base_mip() as i32,
-            s.rsm_resolution.ilog2() as i32,
-        ],
+        shadow_normal_offset: s.shadow_normal_offset,
+        shadow_depth_bias: s.shadow_depth_bias,
+        pcf_radius: s.pcf_radius,
+        shadow_slope_bias: s.shadow_slope_bias,
+        output_size: [s.width, s.height],
+        rsm_resolution: s.rsm_resolution,
+        rsm_top_level: s.rsm_top_level() as i32,
+        exposure: s.exposure,
+        ..Default::default()
     }
 }

@@ -4,32 +4,183 @@
 //! traversal is in `shaders/gather.frag` (`traverse`, with the derivation of
 //! the bound) and reads the quadtree packed into one buffer by the pass
 //! below, starting from its eye-space tile's shared cut (`hisr-cut`); this
-//! module makes the method and its passes and holds its constants.
+//! module declares the method and its parameters, and makes its passes.
 
-use super::gather::{
-    written_for_gather, GatherPass, LightPatches, LightSpacePass, MultiresMethod, PatchList,
-    PatchListPass,
+use super::gather::{GatherPass, LightPatches};
+use super::multires_method::{
+    written_for_gather, LightSpacePass, MultiresMethod, PatchList, PatchListPass,
 };
+use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::{HisrCutHeader, HISR_CUT_LEVELS};
-use crate::passes::{ComputePass, INDIRECT_COMPUTE};
-use crate::settings::RenderSettings;
+use crate::gpu_types::{HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS};
+use crate::multires;
+use crate::passes::{rsm_tree, ComputePass, INDIRECT_COMPUTE};
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::barrier;
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+
+pub const KEY: Method = Method::new("hisr");
+
+/// The deepest tree the packing addresses (`cut_entry` in `shaders/hisr.glsl`
+/// keeps 12 bits per coordinate): an RSM of 4096.
+const MAX_TREE_DEPTH: f64 = 12.0;
+
+/// The largest `--hisr-tile-level` (tiles of 256 x 256 pixels).
+pub const MAX_TILE_LEVEL: u32 = 8;
+
+pub const START_LEVEL: Param<u32> = Param {
+    name: "start-level",
+    help: "HISR starts its traversal from 2^s x 2^s light patches",
+    default: DefaultValue::Fixed(2),
+    range: Range::closed(0.0, MAX_TREE_DEPTH),
+};
+
+pub const MAX_DEPTH: Param<u32> = Param {
+    name: "max-depth",
+    help: "HISR subdivides at most down to 2^d x 2^d light patches (at most log2 of --rsm); \
+           patches spanning a discontinuity are held to 1/100 of tau",
+    default: DefaultValue::Derived(
+        |s| 6.min(s.rsm_top_level()),
+        "6, or log2 of --rsm if smaller",
+    ),
+    range: Range::closed(0.0, MAX_TREE_DEPTH),
+};
+
+pub const TAU: Param<f32> = Param {
+    name: "tau",
+    help: "HISR's error threshold, as a fraction of the light's peak intensity: a light \
+           patch is subdivided while its contribution could exceed tau * I",
+    default: DefaultValue::Fixed(0.05),
+    range: Range::open(0.0, 1.0),
+};
+
+pub const TILE_LEVEL: Param<u32> = Param {
+    name: "hisr-tile-level",
+    help: "HISR finds the traversal shared by each tile of 2^K, 2^(K+1) and 2^(K+2) pixels \
+           a side once per tile (pass hisr-cut); 0 traverses from the roots in every \
+           fragment. Same image either way (up to float rounding)",
+    default: DefaultValue::Fixed(4),
+    range: Range::closed(0.0, MAX_TILE_LEVEL as f64),
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&TAU, &START_LEVEL, &MAX_DEPTH, &TILE_LEVEL];
+
+/// T at the finest level for `tau` given as a fraction of the light's peak
+/// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2)
+/// (`shaders/gather.frag` derives the test; this is the one place T is
+/// computed, for the run uniforms).
+pub fn subdivision_threshold(tau: f32, rsm_resolution: u32) -> f32 {
+    let r2 = rsm_resolution as f64 * rsm_resolution as f64;
+    (2.0 * (1.0 - tau as f64) / (3.0 * tau as f64 * r2)) as f32
+}
+
+pub struct HisrMethod;
+
+impl Descriptor for HisrMethod {
+    fn key(&self) -> Method {
+        KEY
+    }
+    fn help(&self) -> &'static str {
+        "Hierarchical ISR: a per-fragment traversal of the RSM quadtree."
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        &[multires::PARAMS, rsm_tree::PARAMS, PARAMS]
+    }
+    fn uses_multires(&self) -> bool {
+        true
+    }
+    fn check(&self, s: &RenderSettings) -> Result<()> {
+        multires::check(s, KEY.name())?;
+        let top = s.rsm_top_level();
+        let (start, max) = (START_LEVEL.get(s), MAX_DEPTH.get(s));
+        if max > top || start > max {
+            bail!(
+                "--start-level {start} and --max-depth {max} must satisfy start <= max <= log2(--rsm) = {top}"
+            );
+        }
+        Ok(())
+    }
+    fn memory(&self, s: &RenderSettings) -> u64 {
+        let node = std::mem::size_of::<LightPatch>() as u64;
+        multires::memory(s) + packed_nodes(s) * node + cut_bytes(s)
+    }
+    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
+        multires::write_uniforms(s, u);
+        u.hisr_threshold = subdivision_threshold(TAU.get(s), s.rsm_resolution);
+        u.hisr_start_depth = START_LEVEL.get(s) as i32;
+        u.hisr_max_depth = MAX_DEPTH.get(s) as i32;
+    }
+    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
+        sweep(rsm, quick)
+    }
+    fn label(&self, s: &RenderSettings) -> String {
+        let mut l = format!("tau {}, depth {}", TAU.get(s), MAX_DEPTH.get(s));
+        let eye = multires::DEPTH_THRESHOLD.get(s);
+        if eye != multires::DEPTH_THRESHOLD.default_in(s) {
+            l += &format!(", eye depth {eye}");
+        }
+        l
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        Ok(Box::new(new(setup)?))
+    }
+}
+
+/// HISR's points in the bench (docs/algorithm.md section 6.5): tau from its
+/// cheap end to its accurate one, shallower trees at the cheap end, two
+/// eye-space refinement thresholds and, where the RSM allows, one level
+/// deeper at the accurate end.
+fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
+    let tau = |t: f32| Params::new().with(&TAU, t);
+    // Large taus trace the cheap end of HISR's front (at tau 0.97 a valid
+    // patch splits only for receivers very near it, while invalid ones are
+    // still held to tau / 100); smaller max depths at the two largest taus
+    // go cheaper still.
+    let taus: &[f32] = if quick {
+        &[0.2, 0.05]
+    } else {
+        &[0.97, 0.94, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
+    };
+    let mut v: Vec<Params> = taus.iter().map(|&t| tau(t)).collect();
+    if quick {
+        return v;
+    }
+    let deepest = 6.min(rsm.ilog2());
+    let start = START_LEVEL.default_in(&RenderSettings::DEFAULT);
+    for t in [0.97, 0.9] {
+        for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
+            if d >= start {
+                v.push(tau(t).with(&MAX_DEPTH, d));
+            }
+        }
+    }
+    for t in [0.05, 0.3] {
+        v.push(Params::new().with(&multires::DEPTH_THRESHOLD, t));
+    }
+    // The accurate end: one level deeper (single RSM texels at RSM 128),
+    // where the default depth stops near the error of 4^6 = 4096 VPLs.
+    if rsm.ilog2() > deepest {
+        for t in [0.2, 0.1, 0.05, 0.01] {
+            v.push(tau(t).with(&MAX_DEPTH, deepest + 1));
+        }
+    }
+    v
+}
 
 /// Method `hisr`: pass `light-tree-pack` (`shaders/light_tree_pack.comp`)
 /// copies the RSM quadtree's nodes down to the max depth into one buffer, root
 /// first; with tiles (`--hisr-tile-level`), pass `hisr-cut` finds each
 /// eye-space tile's shared cut; then the gather traverses per fragment.
-pub fn new(setup: &Setup) -> Result<MultiresMethod> {
+fn new(setup: &Setup) -> Result<MultiresMethod> {
     let nodes = packed_nodes(setup.settings);
     // One invocation per node: 2^max_depth wide, enough rows for every node.
-    let width = 1u64 << setup.settings.hisr_max_depth();
+    let width = 1u64 << MAX_DEPTH.get(setup.settings);
     let extent = vk::Extent2D {
         width: width as u32,
         height: nodes.div_ceil(width) as u32,
@@ -41,7 +192,7 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
         nodes,
         extent,
     )?;
-    let cut = match setup.settings.light_tree.hisr_tile_level {
+    let cut = match TILE_LEVEL.get(setup.settings) {
         0 => None,
         _ => Some(CutPass::new(setup, pack.buffer())?),
     };
@@ -61,7 +212,7 @@ pub fn new(setup: &Setup) -> Result<MultiresMethod> {
 /// depth never split), so they are not packed: at RSM 1024 and depth 6 that is
 /// 5,461 nodes instead of 1.4 million.
 pub fn packed_nodes(s: &RenderSettings) -> u64 {
-    let side = 1u64 << s.hisr_max_depth();
+    let side = 1u64 << MAX_DEPTH.get(s);
     (4 * side * side - 1) / 3
 }
 
@@ -105,7 +256,7 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile.
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
-    let k = s.light_tree.hisr_tile_level;
+    let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
     let mut tiles = [0u64; HISR_CUT_LEVELS];
     let mut offset = 0u64;
@@ -135,7 +286,7 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
 
 /// Bytes of the cut buffer (0 without tiles).
 pub fn cut_bytes(s: &RenderSettings) -> u64 {
-    if s.light_tree.hisr_tile_level == 0 {
+    if TILE_LEVEL.get(s) == 0 {
         return 0;
     }
     let header = cut_layout(s);
@@ -239,13 +390,6 @@ impl CutPass {
             written_for_gather(ctx);
         });
     }
-}
-
-/// T at the finest level for `tau` given as a fraction of the light's peak
-/// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2).
-pub fn subdivision_threshold(tau: f32, rsm_resolution: u32) -> f32 {
-    let r2 = rsm_resolution as f64 * rsm_resolution as f64;
-    (2.0 * (1.0 - tau as f64) / (3.0 * tau as f64 * r2)) as f32
 }
 
 #[cfg(test)]

@@ -7,33 +7,102 @@
 //! level with an atomic append (a [`PatchListPass`]). Reads the RSM quadtree;
 //! writes the chosen list.
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchList, PatchListPass};
+use super::gather::{GatherPass, LightPatches};
+use super::multires_method::{MultiresMethod, PatchList, PatchListPass};
+use super::{Descriptor, IndirectMethod};
 use crate::frame::Setup;
-use anyhow::{anyhow, Result};
+use crate::gpu_types::{LightPatch, RunUniforms};
+use crate::multires;
+use crate::passes::rsm_tree;
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::{Method, Params, RenderSettings};
+use anyhow::{anyhow, bail, Result};
 
-/// Method `isr`: the selection, then every eye-space patch gathers the list.
-pub fn new(setup: &Setup) -> Result<MultiresMethod> {
-    // The RSM quadtree level to start from (also in the run uniforms); at
-    // most one chosen patch per base texel, one invocation each.
-    let base_extent = setup
-        .targets
-        .rsm_position
-        .mip_extent(setup.settings.isr_base_mip());
-    let base_texels = base_extent.width as u64 * base_extent.height as u64;
-    let select = PatchListPass::new(
-        setup,
-        PatchList::IsrChosen,
-        ("isr-select", "isr_select.comp", "ChosenPatches"),
-        base_texels,
-        base_extent,
-    )?;
-    MultiresMethod::new(setup, Some(Box::new(select)), |setup, m, chosen| {
-        let chosen = chosen.ok_or_else(|| anyhow!("isr gathers from its chosen list"))?;
-        Ok(Box::new(GatherPass::new(
+pub const KEY: Method = Method::new("isr");
+
+pub const BASE: Param<u32> = Param {
+    name: "isr-base",
+    help: "Basic ISR's dense starting level, in patches per side (a power of 2, at most --rsm)",
+    default: DefaultValue::Fixed(64),
+    range: Range::powers_of(2, 1.0, 4096.0),
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&BASE];
+
+/// The RSM quadtree level (mip) Basic ISR starts from.
+pub fn base_level(s: &RenderSettings) -> u32 {
+    s.rsm_top_level() - BASE.get(s).clamp(1, s.rsm_resolution).ilog2()
+}
+
+/// Base texels: at most one chosen patch each.
+fn base_texels(s: &RenderSettings) -> u64 {
+    let side = (s.rsm_resolution >> base_level(s)).max(1) as u64;
+    side * side
+}
+
+pub struct IsrMethod;
+
+impl Descriptor for IsrMethod {
+    fn key(&self) -> Method {
+        KEY
+    }
+    fn help(&self) -> &'static str {
+        "Basic ISR: per-frame clustered light patches, gathered by every eye patch."
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        &[multires::PARAMS, rsm_tree::PARAMS, PARAMS]
+    }
+    fn uses_multires(&self) -> bool {
+        true
+    }
+    fn check(&self, s: &RenderSettings) -> Result<()> {
+        multires::check(s, KEY.name())?;
+        let (base, r) = (BASE.get(s), s.rsm_resolution);
+        if base > r {
+            bail!("--isr-base {base}: the base must be a power of 2 no larger than --rsm {r}");
+        }
+        Ok(())
+    }
+    fn memory(&self, s: &RenderSettings) -> u64 {
+        multires::memory(s) + base_texels(s) * std::mem::size_of::<LightPatch>() as u64
+    }
+    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
+        multires::write_uniforms(s, u);
+        u.isr_base_level = base_level(s) as i32;
+    }
+    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
+        let bases: &[u32] = if quick { &[16, 64] } else { &[16, 32, 64] };
+        bases
+            .iter()
+            .filter(|&&b| b <= rsm)
+            .map(|&b| Params::new().with(&BASE, b))
+            .collect()
+    }
+    fn label(&self, s: &RenderSettings) -> String {
+        format!("base {}", BASE.get(s))
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        // At most one chosen patch per base texel, one invocation each.
+        let base_extent = setup
+            .targets
+            .rsm_position
+            .mip_extent(base_level(setup.settings));
+        let select = PatchListPass::new(
             setup,
-            m,
-            LightPatches::List,
-            chosen,
-        )?))
-    })
+            PatchList::IsrChosen,
+            ("isr-select", "isr_select.comp", "ChosenPatches"),
+            base_texels(setup.settings),
+            base_extent,
+        )?;
+        let method = MultiresMethod::new(setup, Some(Box::new(select)), |setup, m, chosen| {
+            let chosen = chosen.ok_or_else(|| anyhow!("isr gathers from its chosen list"))?;
+            Ok(Box::new(GatherPass::new(
+                setup,
+                m,
+                LightPatches::List,
+                chosen,
+            )?))
+        })?;
+        Ok(Box::new(method))
+    }
 }

@@ -1,34 +1,210 @@
 //! Indirect-light methods, one module each (docs/algorithm.md sections 4 and
-//! 5), behind one interface, [`IndirectMethod`]: each writes the
+//! 5). A method is one unit: its module declares what it is (a
+//! [`Descriptor`]: name, help, parameters with their ranges, capabilities,
+//! checks, GPU memory, uniforms, bench sweep) and makes the object that
+//! records its passes (an [`IndirectMethod`]), which writes the
 //! full-resolution indirect irradiance image `Targets::indirect`, either
-//! through the multiresolution buffer ([`gather::MultiresMethod`]) or directly
-//! at full resolution.
+//! through the multiresolution buffer ([`multires_method::MultiresMethod`])
+//! or directly at full resolution.
 //!
-//! Adding a method: its module here (and its shaders), a variant of
-//! `settings::Method` (its doc comment is the CLI help), and one arm in
-//! [`create`].
+//! Adding a method: its module here (a `Descriptor` and its passes), its
+//! shaders in `shaders/`, and one line in [`REGISTRY`]. `settings::Method`
+//! is only its key; the CLI, checks, viewer and bench read the rest from
+//! the registry.
 
+pub mod args;
 pub mod gather;
 pub mod hisr;
 pub mod isr;
 pub mod multires_gather;
+pub mod multires_method;
 pub mod multires_splat;
 pub mod none;
 pub mod reference;
 pub mod rsm_gather;
 pub mod rsm_splat;
+pub mod vpls;
 
 use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::RunUniforms;
 use crate::multires::MultiresBuffer;
-use crate::settings::Method;
+use crate::settings::params::AnyParam;
+use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, Result};
+pub use args::ParamArgs;
 
-/// One way of computing indirect light. Made once per run (`create`); records
-/// its passes into every frame after the RSM, G-buffer, direct light and (if
-/// it reads it) the RSM quadtree, once per light view, and before the
-/// composite. Its GPU objects
+/// Every method, in the order of the CLI's help, the viewer's `M` key and
+/// the bench's reports: the baselines, then the paper's methods, then the
+/// reference. One line per method.
+pub static REGISTRY: &[&dyn Descriptor] = &[
+    &none::NoneMethod,
+    &rsm_gather::RsmGatherMethod,
+    &rsm_splat::RSM_SPLAT,
+    &rsm_splat::RSM_SPLAT_RESTRICTED,
+    &multires_splat::MultiresSplatMethod,
+    &multires_gather::MultiresGatherMethod,
+    &isr::IsrMethod,
+    &hisr::HisrMethod,
+    &reference::ReferenceMethod,
+];
+
+/// What a method is, before anything is made: everything the CLI, the
+/// checks, the viewer and the bench need to know of it.
+pub trait Descriptor: Sync {
+    /// Its key (its CLI name).
+    fn key(&self) -> Method;
+
+    /// One sentence for `--help` and the README.
+    fn help(&self) -> &'static str;
+
+    /// The parameters it reads, in groups (the shared ones first): each is a
+    /// `--NAME` option and is checked against its range before a run.
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        &[]
+    }
+
+    /// Whether it works through the multiresolution buffer (its
+    /// `IndirectMethod::multires` is then the buffer).
+    fn uses_multires(&self) -> bool {
+        false
+    }
+
+    /// Whether the interactive viewer shows it: it renders a frame in one
+    /// submission, in real time on a GPU.
+    fn interactive(&self) -> bool {
+        true
+    }
+
+    /// Checks across its parameters and the sizes; each parameter's own
+    /// range is checked before (`check`).
+    fn check(&self, _s: &RenderSettings) -> Result<()> {
+        Ok(())
+    }
+
+    /// Bytes of GPU memory its own resources take, for the check before
+    /// anything is allocated.
+    fn memory(&self, _s: &RenderSettings) -> u64 {
+        0
+    }
+
+    /// Writes its fields of the run uniforms (the shared ones are written
+    /// before).
+    fn write_uniforms(&self, _s: &RenderSettings, _u: &mut RunUniforms) {}
+
+    /// The bench's sweep over its parameters for RSM resolution `rsm`: each
+    /// point the values it sets; `quick` keeps two or three. Empty: the
+    /// bench does not sweep it. One point sets nothing or only defaults.
+    fn sweep(&self, _rsm: u32, _quick: bool) -> Vec<Params> {
+        vec![]
+    }
+
+    /// A short label for tables and charts: "256 VPLs", "tau 0.05, depth 6".
+    fn label(&self, _s: &RenderSettings) -> String {
+        self.key().name().into()
+    }
+
+    /// Light patches evaluated per pixel with geometry, where that is fixed
+    /// (the full-resolution methods that evaluate every VPL everywhere);
+    /// the multiresolution methods count theirs on the GPU.
+    fn evaluations_per_pixel(&self, _s: &RenderSettings) -> Option<u64> {
+        None
+    }
+
+    /// Makes it for a run.
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>>;
+}
+
+/// The descriptor of `m`.
+pub fn find(m: Method) -> Result<&'static dyn Descriptor> {
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|d| d.key() == m)
+        .ok_or_else(|| {
+            anyhow!(
+                "unknown method '{m}'; the methods are: {}",
+                names().join(", ")
+            )
+        })
+}
+
+/// The descriptor named `name` (the CLI's spelling).
+pub fn by_name(name: &str) -> Result<&'static dyn Descriptor> {
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|d| d.key().name() == name)
+        .ok_or_else(|| {
+            anyhow!(
+                "unknown method '{name}'; the methods are: {}",
+                names().join(", ")
+            )
+        })
+}
+
+/// Every method's name, in registry order.
+pub fn names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|d| d.key().name()).collect()
+}
+
+/// Every parameter of `d`.
+pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyParam> {
+    d.params().iter().flat_map(|g| g.iter().copied())
+}
+
+/// Every parameter of every method, once each, in registry order.
+pub fn all_params() -> Vec<&'static dyn AnyParam> {
+    let mut out: Vec<&'static dyn AnyParam> = vec![];
+    for &d in REGISTRY {
+        for p in params_of(d) {
+            if !out.iter().any(|q| q.name() == p.name()) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// Checks `s` for its method: every parameter the method reads, and every
+/// one `s` sets (a value out of range is wrong even where it has no
+/// effect), against its range; then the method's own checks. Returns the
+/// method's descriptor.
+pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
+    let d = find(s.method)?;
+    for p in all_params() {
+        if p.is_set_in(s) || params_of(d).any(|q| q.name() == p.name()) {
+            p.check(s)?;
+        }
+    }
+    d.check(s)?;
+    Ok(d)
+}
+
+/// The parameters `s` sets that its method does not read (the CLI warns of
+/// them: they have no effect).
+pub fn unused_params(s: &RenderSettings) -> Vec<&'static str> {
+    let Ok(d) = find(s.method) else {
+        return vec![];
+    };
+    s.params
+        .0
+        .keys()
+        .copied()
+        .filter(|name| !params_of(d).any(|p| p.name() == *name))
+        .collect()
+}
+
+/// Whether `s` holds its method's default values (of every parameter the
+/// method reads) as `base` does: the bench's default point.
+pub fn same_params(d: &dyn Descriptor, s: &RenderSettings, base: &RenderSettings) -> bool {
+    params_of(d).all(|p| p.text_in(s) == p.text_in(base))
+}
+
+/// The object a method makes for a run: records its passes into every
+/// frame after the RSM, G-buffer, direct light and (if it reads it) the RSM
+/// quadtree, once per light view, and before the composite. Its GPU objects
 /// free themselves when it is dropped.
 pub trait IndirectMethod {
     /// Command buffers one frame of the method takes: the reference splits its
@@ -72,18 +248,81 @@ pub trait IndirectMethod {
 
 /// The method `setup.settings.method` names, made for `setup`.
 pub fn create(setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
-    Ok(match setup.settings.method {
-        Method::None => Box::new(none::NoIndirect::new(setup)?),
-        Method::MultiresGather => Box::new(multires_gather::new(setup)?),
-        Method::Isr => Box::new(isr::new(setup)?),
-        Method::Hisr => Box::new(hisr::new(setup)?),
-        Method::RsmGather => Box::new(rsm_gather::RsmGather::new(setup)?),
-        Method::RsmSplat => Box::new(rsm_splat::RsmSplat::new(setup, false)?),
-        Method::RsmSplatRestricted => Box::new(rsm_splat::RsmSplat::new(setup, true)?),
-        Method::MultiresSplat => Box::new(multires_splat::new(setup)?),
-        Method::Reference => Box::new(reference::Reference::new(setup)?),
-        Method::Pathtrace => bail!(
-            "method pathtrace runs on the CPU (isr::pathtrace::render), not in the Vulkan renderer"
-        ),
-    })
+    let d = find(setup.settings.method)?;
+    let method = d.create(setup)?;
+    if method.multires().is_some() != d.uses_multires() {
+        bail!(
+            "method {} says it {} the multiresolution buffer, but its object {}",
+            d.key(),
+            if d.uses_multires() {
+                "uses"
+            } else {
+                "does not use"
+            },
+            if d.uses_multires() {
+                "has none"
+            } else {
+                "has one"
+            }
+        );
+    }
+    Ok(method)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_the_default_is_registered() {
+        let mut n = names();
+        n.sort();
+        n.dedup();
+        assert_eq!(n.len(), REGISTRY.len());
+        assert!(find(RenderSettings::DEFAULT.method).is_ok());
+        assert!(by_name("pathtrace").is_err());
+    }
+
+    #[test]
+    fn parameters_with_one_name_are_one_parameter() {
+        // Two methods listing a parameter of the same name must list the
+        // same declaration (one range, one default).
+        let all = all_params();
+        for &d in REGISTRY {
+            for p in params_of(d) {
+                let q = all.iter().find(|q| q.name() == p.name()).unwrap();
+                assert!(
+                    std::ptr::addr_eq(*q as *const dyn AnyParam, p as *const dyn AnyParam)
+                        || (q.range() == p.range() && q.help() == p.help()),
+                    "two declarations of --{}",
+                    p.name()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_sweep_holds_its_default_once_and_only_valid_points() {
+        let base = RenderSettings {
+            rsm_resolution: 128,
+            ..RenderSettings::DEFAULT
+        };
+        for &d in REGISTRY {
+            for quick in [false, true] {
+                let points = d.sweep(128, quick);
+                let mut defaults = 0;
+                for p in &points {
+                    let mut s = base.clone().with_method(d.key());
+                    s.params.overlay(p);
+                    for q in params_of(d) {
+                        q.check(&s).unwrap();
+                    }
+                    defaults += same_params(d, &s, &base.clone().with_method(d.key())) as usize;
+                }
+                if !points.is_empty() {
+                    assert_eq!(defaults, 1, "{} quick={quick}", d.key());
+                }
+            }
+        }
+    }
 }

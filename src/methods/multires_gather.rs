@@ -5,30 +5,74 @@
 //! buffer once per frame, which the gather then loops over as Basic ISR's
 //! list; the other passes are those of [`MultiresMethod`].
 
-use super::gather::{GatherPass, LightPatches, MultiresMethod, PatchList, PatchListPass};
+use super::gather::{GatherPass, LightPatches};
+use super::multires_method::{MultiresMethod, PatchList, PatchListPass};
+use super::vpls::{self, RegularVpls};
+use super::{Descriptor, IndirectMethod};
 use crate::frame::Setup;
+use crate::gpu_types::{LightPatch, RunUniforms};
+use crate::multires;
+use crate::settings::params::AnyParam;
+use crate::settings::{Method, Params, RenderSettings};
 use anyhow::{anyhow, Result};
 use ash::vk;
 
-pub fn new(setup: &Setup) -> Result<MultiresMethod> {
-    let side = (setup.settings.vpls as f64).sqrt() as u32;
-    let list = PatchListPass::new(
-        setup,
-        PatchList::RegularVpls,
-        ("vpl-list", "vpl_list.comp", "VplList"),
-        setup.settings.vpls as u64,
-        vk::Extent2D {
-            width: side,
-            height: side,
-        },
-    )?;
-    MultiresMethod::new(setup, Some(Box::new(list)), |setup, m, list| {
-        let list = list.ok_or_else(|| anyhow!("multires-gather gathers from its VPL list"))?;
-        Ok(Box::new(GatherPass::new(
+pub const KEY: Method = Method::new("multires-gather");
+
+pub struct MultiresGatherMethod;
+
+impl Descriptor for MultiresGatherMethod {
+    fn key(&self) -> Method {
+        KEY
+    }
+    fn help(&self) -> &'static str {
+        "Stenciled gathering from N regular VPLs into the multiresolution buffer."
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        &[multires::PARAMS, vpls::PARAMS]
+    }
+    fn uses_multires(&self) -> bool {
+        true
+    }
+    fn check(&self, s: &RenderSettings) -> Result<()> {
+        multires::check(s, KEY.name())?;
+        vpls::check(s)
+    }
+    fn memory(&self, s: &RenderSettings) -> u64 {
+        let list = RegularVpls::of(s).count as u64 * std::mem::size_of::<LightPatch>() as u64;
+        multires::memory(s) + list
+    }
+    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
+        multires::write_uniforms(s, u);
+        RegularVpls::of(s).write_uniforms(s, u);
+    }
+    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
+        vpls::sweep(rsm, quick)
+    }
+    fn label(&self, s: &RenderSettings) -> String {
+        vpls::label(s)
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        let v = RegularVpls::of(setup.settings);
+        let list = PatchListPass::new(
             setup,
-            m,
-            LightPatches::List,
-            list,
-        )?))
-    })
+            PatchList::RegularVpls,
+            ("vpl-list", "vpl_list.comp", "VplList"),
+            v.count as u64,
+            vk::Extent2D {
+                width: v.side,
+                height: v.side,
+            },
+        )?;
+        let method = MultiresMethod::new(setup, Some(Box::new(list)), |setup, m, list| {
+            let list = list.ok_or_else(|| anyhow!("multires-gather gathers from its VPL list"))?;
+            Ok(Box::new(GatherPass::new(
+                setup,
+                m,
+                LightPatches::List,
+                list,
+            )?))
+        })?;
+        Ok(Box::new(method))
+    }
 }

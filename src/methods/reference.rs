@@ -17,14 +17,60 @@
 
 use super::rsm_gather::full_resolution_bindings;
 use super::rsm_splat::require_blending;
-use super::IndirectMethod;
+use super::vpls::RegularVpls;
+use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::{Method, RenderSettings};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 use ash::vk;
+
+pub const KEY: Method = Method::new("reference");
+
+/// The reference's light-patch evaluations per submission.
+pub const CHUNK: Param<u64> = Param {
+    name: "reference-chunk",
+    help: "--method reference: light-patch evaluations per submission (pixels x VPLs). \
+           The default keeps a submission near half a second on lavapipe; on a GPU, \
+           larger chunks cut the per-submission overhead",
+    default: DefaultValue::Fixed(1 << 26),
+    range: Range::at_least(1.0),
+};
+
+const PARAMS: &[&dyn AnyParam] = &[&CHUNK];
+
+pub struct ReferenceMethod;
+
+impl Descriptor for ReferenceMethod {
+    fn key(&self) -> Method {
+        KEY
+    }
+    fn help(&self) -> &'static str {
+        "Every pixel gathers every RSM texel (R^2 VPLs), in chunks."
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        // Its VPLs are every RSM texel: --vpls and --vpl-sampling do not apply.
+        &[PARAMS]
+    }
+    /// Many submissions a frame: seconds on lavapipe, not for a window.
+    fn interactive(&self) -> bool {
+        false
+    }
+    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
+        RegularVpls::every_texel(s).write_uniforms(s, u);
+    }
+    fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
+        Some(RegularVpls::every_texel(s).count as u64)
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        Ok(Box::new(Reference::new(setup)?))
+    }
+}
 
 pub struct Reference {
     pipeline: PassPipeline,
@@ -33,7 +79,7 @@ pub struct Reference {
 }
 
 impl Reference {
-    /// Chunks of at most `settings.reference_chunk` light-patch evaluations
+    /// Chunks of at most `--reference-chunk` light-patch evaluations
     /// (pixels x VPLs) each.
     pub fn new(setup: &Setup) -> Result<Self> {
         let s = setup.settings;
@@ -52,9 +98,9 @@ impl Reference {
                 ..Default::default()
             },
         )?;
-        let total = s.rsm_resolution * s.rsm_resolution;
+        let total = RegularVpls::every_texel(s).count;
         let pixels = s.width as u64 * s.height as u64;
-        let per_chunk = (s.reference_chunk.max(1) / pixels).clamp(1, total as u64) as u32;
+        let per_chunk = (CHUNK.get(s).max(1) / pixels).clamp(1, total as u64) as u32;
         let chunks = (0..total.div_ceil(per_chunk))
             .map(|c| (c * per_chunk, ((c + 1) * per_chunk).min(total)))
             .collect();

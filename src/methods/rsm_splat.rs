@@ -7,15 +7,82 @@
 //! writes `indirect` (barriers below).
 
 use super::rsm_gather::full_resolution_bindings;
-use super::IndirectMethod;
+use super::vpls::{self, RegularVpls};
+use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, Attachments, INDIRECT_GRAPHICS};
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
 use crate::vk::Gpu;
 use anyhow::{bail, Result};
 use ash::vk;
+
+/// Restricted splats skip where a VPL's irradiance bound is below this (W/m^2).
+pub const THRESHOLD: Param<f32> = Param {
+    name: "splat-threshold",
+    help: "Restricted splats: a VPL's quad covers only where its irradiance bound \
+           Phi / (pi d^2) exceeds this (W/m^2); 0 gives full-screen splats",
+    default: DefaultValue::Fixed(0.01),
+    range: Range::at_least(0.0),
+};
+
+const RESTRICTED_PARAMS: &[&dyn AnyParam] = &[&THRESHOLD];
+
+/// `rsm-splat` and `rsm-splat-restricted`: one module, two methods.
+pub struct RsmSplatMethod {
+    restricted: bool,
+}
+
+pub static RSM_SPLAT: RsmSplatMethod = RsmSplatMethod { restricted: false };
+pub static RSM_SPLAT_RESTRICTED: RsmSplatMethod = RsmSplatMethod { restricted: true };
+
+impl Descriptor for RsmSplatMethod {
+    fn key(&self) -> Method {
+        match self.restricted {
+            false => Method::new("rsm-splat"),
+            true => Method::new("rsm-splat-restricted"),
+        }
+    }
+    fn help(&self) -> &'static str {
+        match self.restricted {
+            false => "Each VPL splats a full-screen quad, additively.",
+            true => "Each VPL splats a quad bounded to where it can exceed --splat-threshold.",
+        }
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        match self.restricted {
+            false => &[vpls::PARAMS],
+            true => &[vpls::PARAMS, RESTRICTED_PARAMS],
+        }
+    }
+    fn check(&self, s: &RenderSettings) -> Result<()> {
+        vpls::check(s)
+    }
+    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
+        RegularVpls::of(s).write_uniforms(s, u);
+        if self.restricted {
+            u.splat_threshold = THRESHOLD.get(s);
+        }
+    }
+    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
+        vpls::sweep(rsm, quick)
+    }
+    fn label(&self, s: &RenderSettings) -> String {
+        vpls::label(s)
+    }
+    /// Full-screen splats evaluate every VPL at every pixel; restricted ones
+    /// fewer, uncounted.
+    fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
+        (!self.restricted).then_some(RegularVpls::of(s).count as u64)
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        Ok(Box::new(RsmSplat::new(setup, self.restricted)?))
+    }
+}
 
 /// Fails with a clear message when `format` cannot be blended into.
 pub fn require_blending(gpu: &Gpu, format: vk::Format, method: &str) -> Result<()> {
@@ -55,7 +122,7 @@ impl RsmSplat {
         )?;
         Ok(Self {
             pipeline,
-            vpls: setup.settings.vpls,
+            vpls: RegularVpls::of(setup.settings).count,
         })
     }
 }

@@ -44,7 +44,7 @@ impl UpsamplePass {
             Binding::storage_image("taps", m.upsample_taps.view),
         ];
         // From these settings; a change of settings rebuilds the passes.
-        let interpolate = (setup.settings.multires.upsample == Upsample::Interpolated) as i32;
+        let interpolate = (super::UPSAMPLE.get(setup.settings) == Upsample::Interpolated) as i32;
         let pass = |pull: bool, taps: bool| {
             ComputePass::new(
                 setup,

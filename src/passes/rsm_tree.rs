@@ -3,13 +3,47 @@
 //! level, level k merging 2x2 texels of level k - 1 and flagging patches that
 //! span a discontinuity.
 //! Reads RSM mip 0; writes RSM mips 1.. (barriers below).
+//!
+//! Its parameters, the validity thresholds, matter to the methods that take
+//! patches whole (`isr`, `hisr`), which list them.
 
 use super::{ComputePass, INDIRECT_COMPUTE};
 use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::RunUniforms;
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::RenderSettings;
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
+
+/// A patch is valid (one surface) when each non-empty child's mean lies
+/// within this fraction of its distance to the light (for an orthographic
+/// RSM, of the RSM's half side) of the patch's plane...
+pub const VALIDITY_DEPTH: Param<f32> = Param {
+    name: "light-depth-threshold",
+    help: "Light patches merge only when each child lies within this fraction of its \
+           distance to the light from the merged patch's plane",
+    default: DefaultValue::Fixed(0.1),
+    range: Range::at_least(0.0),
+};
+
+/// ... and their normals by less than this angle (degrees).
+pub const VALIDITY_NORMAL: Param<f32> = Param {
+    name: "light-normal-threshold",
+    help: "Light patches merge only when each child's normal is within this angle \
+           (degrees) of the merged patch's",
+    default: DefaultValue::Fixed(30.0),
+    range: Range::closed(0.0, 180.0),
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&VALIDITY_DEPTH, &VALIDITY_NORMAL];
+
+/// The validity thresholds in the run uniforms (every run builds the tree).
+pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
+    u.validity_depth = VALIDITY_DEPTH.get(s);
+    u.validity_normal_cos = VALIDITY_NORMAL.get(s).to_radians().cos();
+}
 
 pub struct RsmTreePass(ComputePass);
 

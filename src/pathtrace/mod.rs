@@ -243,6 +243,14 @@ impl Shading<'_> {
 }
 
 /// What `render` needs besides the scene.
+/// Its name on the command line: `isr render --method pathtrace` runs it
+/// instead of a GPU method (it is not in the GPU methods' registry).
+pub const NAME: &str = "pathtrace";
+
+/// Its line in `--method`'s help.
+pub const HELP: &str =
+    "One-bounce path tracing with indirect visibility, on the CPU (isr render only).";
+
 #[derive(Clone, Debug)]
 pub struct PathTraceSettings {
     pub width: u32,

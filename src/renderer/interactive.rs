@@ -97,8 +97,7 @@ impl<'g> Renderer<'g> {
         {
             bail!("set_method_settings cannot change the output size or the RSM resolution");
         }
-        check_settings(self.gpu, settings)?;
-        check_light_views(
+        let descriptor = check_run(
             self.gpu,
             settings,
             &self.state.lights,
@@ -121,8 +120,9 @@ impl<'g> Renderer<'g> {
         for slot in &mut self.slots {
             slot.profiler = Profiler::new(gpu, passes)?;
         }
-        let bytes = bytemuck::bytes_of(&run_uniforms(settings)).to_vec();
-        let run = self._run_uniforms.buffer;
+        let values = run_uniforms(descriptor, settings);
+        let bytes = bytemuck::bytes_of(&values).to_vec();
+        let run = self.run_uniforms.0.buffer;
         gpu.run_once(|cmd| unsafe {
             // No frame is in flight (waited above); the update's writes
             // become visible to every later frame's reads.
@@ -137,6 +137,7 @@ impl<'g> Renderer<'g> {
             );
         })?;
         self.method = method;
+        self.run_uniforms.1 = values;
         self.settings = settings.clone();
         Ok(())
     }

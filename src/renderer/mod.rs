@@ -9,18 +9,18 @@
 //! between frames (camera, light, instance transforms) is data in the frame
 //! set of the frame's slot, written just before it is submitted.
 
-use crate::frame::check::{check_light_views, check_settings};
-use crate::frame::uniforms::{frame_uniforms, instance_transforms, run_uniforms};
+use crate::frame::check::{check_light_views, check_ranges, check_settings, AddedMemory};
+use crate::frame::uniforms::{frame_uniforms, instance_transforms};
 use crate::frame::{FrameContext, FrameSet, Samplers, SceneGpu, Setup, Targets};
-use crate::gpu_types::{FrameUniforms, LightPatch};
-use crate::methods::IndirectMethod;
+use crate::gpu_types::{FrameUniforms, LightPatch, RunUniforms};
+use crate::methods::{Descriptor, IndirectMethod};
 use crate::multires::MultiresBuffer;
 use crate::passes::light_sum::{LightSumPass, SumStep};
 use crate::passes::rsm_cube::CubeRsmPass;
-use crate::passes::rsm_tree::RsmTreePass;
+use crate::passes::rsm_tree::{self, RsmTreePass};
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::readback::{self, MultiresReadback, Readback};
-use crate::scene::{FrameState, Scene};
+use crate::scene::{FrameState, LightKind, Scene};
 use crate::settings::RenderSettings;
 use crate::view::{light_views, LightView};
 use crate::vk::profiler::{PassSample, Profiler};
@@ -31,7 +31,7 @@ use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
 pub use interactive::FrameExtension;
-pub use stats::FrameStats;
+pub use stats::{median, FrameStats};
 use std::time::Instant;
 
 pub use crate::frame::FRAMES_IN_FLIGHT;
@@ -139,7 +139,8 @@ pub struct Renderer<'g> {
     slots: Vec<Slot<'g>>,
     next_slot: usize,
     frames_submitted: u32,
-    _run_uniforms: Buffer,
+    /// The run uniforms' buffer, and the values it holds.
+    run_uniforms: (Buffer, RunUniforms),
     pub scene: SceneGpu,
     pub targets: Targets,
     _samplers: Samplers,
@@ -149,11 +150,10 @@ impl<'g> Renderer<'g> {
     /// Makes everything a run of `settings` on `scene` needs; the first frame
     /// shows `scene.rest_state()`. Whatever was made before an error is freed.
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
-        check_settings(gpu, settings)?;
         let bounds = scene.bounds().unwrap_or((glam::Vec3::ZERO, glam::Vec3::X));
         let state = scene.rest_state();
         let views = all_views(&state, bounds, settings.rsm_resolution);
-        check_light_views(
+        let descriptor = check_run(
             gpu,
             settings,
             &scene.lights,
@@ -164,10 +164,11 @@ impl<'g> Renderer<'g> {
         let scene_gpu =
             SceneGpu::new(gpu, scene, samplers.texture).context("uploading the scene")?;
         let targets = Targets::new(gpu, settings)?;
+        let run_values = run_uniforms(descriptor, settings);
         let run_uniforms = Buffer::with_data(
             gpu,
             "run uniforms",
-            bytemuck::bytes_of(&run_uniforms(settings)),
+            bytemuck::bytes_of(&run_values),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
         // The slots' profilers are sized once the method says how many
@@ -231,7 +232,7 @@ impl<'g> Renderer<'g> {
             slots,
             next_slot: 0,
             frames_submitted: 0,
-            _run_uniforms: run_uniforms,
+            run_uniforms: (run_uniforms, run_values),
             scene: scene_gpu,
             targets,
             _samplers: samplers,
@@ -265,6 +266,11 @@ impl<'g> Renderer<'g> {
     /// light view.
     pub fn frame_uniforms(&self) -> FrameUniforms {
         self.view_uniforms(0)
+    }
+
+    /// The run uniforms every frame reads (fixed until a method switch).
+    pub fn run_uniforms(&self) -> RunUniforms {
+        self.run_uniforms.1
     }
 
     /// The frame uniforms of light view `v` (an index into `light_views`).
@@ -562,6 +568,44 @@ impl<'g> Renderer<'g> {
     pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
         Ok(self.isr_chosen()?.map(|c| c.len() as u32))
     }
+}
+
+/// Checks `settings` for a run with `lights` (`views` RSMs, `instances`
+/// transforms) on `gpu` before anything is allocated: the shared sizes, the
+/// method's parameters and checks, then the memory it all takes. Returns
+/// the method's descriptor.
+fn check_run(
+    gpu: &Gpu,
+    settings: &RenderSettings,
+    lights: &[crate::scene::Light],
+    views: usize,
+    instances: usize,
+) -> Result<&'static dyn Descriptor> {
+    check_ranges(settings)?;
+    let d = crate::methods::check(settings)?;
+    let method = d.memory(settings);
+    check_settings(gpu, settings, method)?;
+    let cube_rsm = match lights.iter().any(|l| l.kind == LightKind::Point) {
+        true => crate::passes::rsm_cube::cube_bytes(settings.rsm_resolution),
+        false => 0,
+    };
+    check_light_views(
+        gpu,
+        settings,
+        lights,
+        (views, instances),
+        AddedMemory { method, cube_rsm },
+    )?;
+    Ok(d)
+}
+
+/// The run uniforms of `s`: the shared fields, the RSM tree's, then the
+/// method's (`d`).
+fn run_uniforms(d: &dyn Descriptor, s: &RenderSettings) -> RunUniforms {
+    let mut u = crate::frame::uniforms::run_uniforms(s);
+    rsm_tree::write_uniforms(s, &mut u);
+    d.write_uniforms(s, &mut u);
+    u
 }
 
 /// Every light view of `state`'s lights, in light order.

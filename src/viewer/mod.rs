@@ -14,7 +14,7 @@ pub mod script;
 use crate::gpu_types::{PRESENT_VIEW_FINAL, PRESENT_VIEW_HOST, PRESENT_VIEW_INDIRECT};
 use crate::renderer::Renderer;
 use crate::scene::Scene;
-use crate::settings::{Method, RenderSettings};
+use crate::settings::{Method, Param, ParamType, RenderSettings};
 use crate::vk::swapchain::{Semaphores, Surface, Swapchain};
 use crate::vk::{Gpu, GpuOptions};
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -43,13 +43,13 @@ pub struct ViewOptions {
 }
 
 /// Methods `M` cycles through: every GPU method that renders a frame in one
-/// submission (`reference` takes seconds per frame in chunks, `pathtrace`
-/// runs on the CPU).
+/// submission (`methods::Descriptor::interactive`: not `reference`, which
+/// takes seconds per frame in chunks; `pathtrace` runs on the CPU).
 pub fn interactive_methods() -> Vec<Method> {
-    Method::all()
+    crate::methods::REGISTRY
         .iter()
-        .copied()
-        .filter(|m| !matches!(m, Method::Reference | Method::Pathtrace))
+        .filter(|d| d.interactive())
+        .map(|d| d.key())
         .collect()
 }
 
@@ -327,19 +327,12 @@ impl<'g> Viewer<'g> {
                 self.switch(s, "method")
             }
             Key::TauDown | Key::TauUp => {
-                let mut s = self.renderer.settings.clone();
                 let f = if key == Key::TauUp { 2.0 } else { 0.5 };
-                s.light_tree.tau = (s.light_tree.tau * f).clamp(1.0 / 1024.0, 0.5);
-                self.switch(s, "tau")
+                self.scale(&crate::methods::hisr::TAU, f, "tau")
             }
             Key::VplsDown | Key::VplsUp => {
-                let mut s = self.renderer.settings.clone();
-                s.vpls = if key == Key::VplsUp {
-                    s.vpls.saturating_mul(4)
-                } else {
-                    (s.vpls / 4).max(1)
-                };
-                self.switch(s, "VPLs")
+                let f = if key == Key::VplsUp { 4.0 } else { 0.25 };
+                self.scale(&crate::methods::vpls::VPLS, f, "VPLs")
             }
             Key::View => {
                 self.shown = self.shown.next();
@@ -384,6 +377,16 @@ impl<'g> Viewer<'g> {
     }
 
     /// Switches the method or its parameters: only the method's resources are made anew.
+    /// Multiplies parameter `p` by `factor`, kept inside its range (a step
+    /// toward an open bound goes halfway to it), and switches to it.
+    fn scale<T: Scalable>(&mut self, p: &Param<T>, factor: f64, what: &str) -> Result<()> {
+        let mut s = self.renderer.settings.clone();
+        let old = p.get(&s);
+        let new = p.clamp_from(old, T::from_f64(old.to_f64() * factor));
+        p.set(&mut s, T::from_f64(new));
+        self.switch(s, what)
+    }
+
     fn switch(&mut self, settings: RenderSettings, what: &str) -> Result<()> {
         let started = Instant::now();
         self.renderer.set_method_settings(&settings)?;
@@ -588,5 +591,29 @@ impl<'g> Viewer<'g> {
             ..Default::default()
         };
         self.overlay_updated = Some(now);
+    }
+}
+
+/// A numeric parameter the viewer's keys scale.
+trait Scalable: ParamType {
+    fn to_f64(self) -> f64;
+    fn from_f64(x: f64) -> Self;
+}
+
+impl Scalable for f32 {
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+}
+
+impl Scalable for u32 {
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    fn from_f64(x: f64) -> Self {
+        x.round().clamp(0.0, u32::MAX as f64) as u32
     }
 }

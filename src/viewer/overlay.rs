@@ -65,9 +65,10 @@ pub fn cells(s: &Shown) -> Vec<u32> {
         (
             0,
             format!(
-                "vpls {}  tau {}  view {}",
-                settings.effective_vpls(),
-                settings.light_tree.tau,
+                "{}  view {}",
+                crate::methods::find(settings.method)
+                    .map(|d| d.label(settings))
+                    .unwrap_or_default(),
                 s.view
             ),
         ),

@@ -165,6 +165,7 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
         .expect("readback")
         .expect("a multiresolution method");
     let uniforms = r.frame_uniforms();
+    let run = r.run_uniforms();
     let total_area = r.multires().expect("a multiresolution method").total_area();
     drop(r);
     assert_validation_clean(gpu);
@@ -173,7 +174,7 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
         multires,
         stats,
         uniforms,
-        run: isr::frame::uniforms::run_uniforms(settings),
+        run,
         total_area,
     }
 }

@@ -1,0 +1,145 @@
+//! The options `isr render` and `isr view` share ([`RunArgs`]: the scene, the
+//! method and its parameters, the sizes, the device), flattened into both
+//! commands; the method parameters (`methods::ParamArgs`) are flattened into
+//! `isr bench` too.
+
+use crate::methods::{self, ParamArgs};
+use crate::settings::{Method, RenderSettings};
+use crate::vk::{GpuOptions, Validation};
+use anyhow::{bail, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Every default below comes from `RenderSettings::DEFAULT`, which the
+/// library and the benchmarks use too.
+const D: RenderSettings = RenderSettings::DEFAULT;
+
+/// What `--method` names: a GPU method of the registry, or the CPU path
+/// tracer, which is a renderer of its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodArg {
+    Gpu(Method),
+    PathTrace,
+}
+
+impl MethodArg {
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodArg::Gpu(m) => m.name(),
+            MethodArg::PathTrace => crate::pathtrace::NAME,
+        }
+    }
+}
+
+/// `--method`'s values, each with its help: the registry's, then `pathtrace`.
+fn method_parser() -> impl clap::builder::TypedValueParser<Value = MethodArg> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    let mut values: Vec<PossibleValue> = methods::REGISTRY
+        .iter()
+        .map(|d| PossibleValue::new(d.key().name()).help(d.help()))
+        .collect();
+    values.push(PossibleValue::new(crate::pathtrace::NAME).help(crate::pathtrace::HELP));
+    PossibleValuesParser::new(values).map(|name| match methods::by_name(&name) {
+        Ok(d) => MethodArg::Gpu(d.key()),
+        Err(_) => MethodArg::PathTrace,
+    })
+}
+
+#[derive(Args, Clone)]
+pub struct RunArgs {
+    /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Let the scene's buffer and image URIs name files outside its folder
+    /// (absolute paths, '..', file: URIs, symbolic links out of it).
+    #[arg(long)]
+    pub allow_outside_uris: bool,
+    /// How indirect light is computed.
+    #[arg(long, value_parser = method_parser(), default_value = D.method.name())]
+    pub method: MethodArg,
+    /// Output width in pixels.
+    #[arg(long, default_value_t = D.width)]
+    pub width: u32,
+    /// Output height in pixels.
+    #[arg(long, default_value_t = D.height)]
+    pub height: u32,
+    /// Reflective shadow map resolution R (R x R, a power of two).
+    #[arg(long, default_value_t = D.rsm_resolution)]
+    pub rsm: u32,
+    /// Multiplier on radiance before the PNG's sRGB encoding.
+    #[arg(long, default_value_t = D.exposure)]
+    pub exposure: f32,
+    /// Animation time in seconds: the scene's glTF animations (and the
+    /// --orbit-* motion) at this time. With --sequence, the first frame's time.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub time: f32,
+    /// Load the Khronos validation layer with synchronization validation; exit
+    /// non-zero if it reports anything.
+    #[arg(long)]
+    pub validate: bool,
+    /// Device index from `isr devices` (default: discrete > integrated > virtual > CPU).
+    #[arg(long)]
+    pub device: Option<usize>,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+impl RunArgs {
+    /// The settings of a run of GPU method `method`, warning of parameters
+    /// it does not read.
+    pub fn settings(&self, method: Method) -> RenderSettings {
+        let s = RenderSettings {
+            width: self.width,
+            height: self.height,
+            rsm_resolution: self.rsm,
+            method,
+            exposure: self.exposure,
+            params: self.params.0.clone(),
+            ..RenderSettings::default()
+        };
+        for name in methods::unused_params(&s) {
+            eprintln!("warning: method {method} does not read --{name}; it has no effect");
+        }
+        s
+    }
+
+    /// The scene: `--scene`'s file, or the built-in Cornell box.
+    pub fn load_scene(&self) -> Result<crate::scene::Scene> {
+        let scene = match &self.scene {
+            Some(path) => crate::scene::gltf_load::load_with(
+                path,
+                &crate::scene::gltf_load::LoadOptions {
+                    allow_outside_uris: self.allow_outside_uris,
+                    ..Default::default()
+                },
+            )?,
+            None => crate::scene::cornell::cornell_box(),
+        };
+        for w in &scene.warnings {
+            eprintln!("warning: {w}");
+        }
+        Ok(scene)
+    }
+
+    pub fn gpu_options(&self) -> GpuOptions {
+        GpuOptions {
+            validation: if self.validate {
+                Validation::Required
+            } else {
+                Validation::Off
+            },
+            device_index: self.device,
+        }
+    }
+
+    /// `--time` is a finite number.
+    pub fn check_time(&self) -> Result<()> {
+        if !self.time.is_finite() {
+            bail!(
+                "--time {}: the animation time must be a finite number of seconds",
+                self.time
+            );
+        }
+        Ok(())
+    }
+}

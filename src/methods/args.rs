@@ -1,0 +1,108 @@
+//! Every registered parameter as a command-line option: `--NAME VALUE`, one
+//! per parameter of any method (`all_params`), with its help, default and
+//! range in `--help`. `isr render`, `isr view` and `isr bench` flatten
+//! [`ParamArgs`] into their arguments (`#[command(flatten)]`), so a
+//! parameter declared in its method's module reaches every command without
+//! a line of CLI code. Values are parsed for their type here and checked
+//! against their ranges with the other settings (`methods::check`).
+
+use super::{all_params, params_of, REGISTRY};
+use crate::settings::params::AnyParam;
+use crate::settings::{Params, Value};
+
+/// The parameters given on the command line (the others keep their defaults).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ParamArgs(pub Params);
+
+/// `--help`'s text for `p`: its help, default, range and the methods that read it.
+fn help_text(p: &dyn AnyParam) -> String {
+    let readers: Vec<&str> = REGISTRY
+        .iter()
+        .filter(|d| params_of(**d).any(|q| q.name() == p.name()))
+        .map(|d| d.key().name())
+        .collect();
+    let range = match *p.range() {
+        r if r == crate::settings::Range::ANY => String::new(),
+        r => format!("; {}", r.describe()),
+    };
+    format!(
+        "{}. [default: {}{range}] [methods: {}]",
+        p.help(),
+        p.default_text(),
+        readers.join(", ")
+    )
+}
+
+impl clap::FromArgMatches for ParamArgs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut args = Self::default();
+        args.update_from_arg_matches(m)?;
+        Ok(args)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        for p in all_params() {
+            if let Some(v) = m.get_one::<Value>(p.name()) {
+                self.0.insert(p.name(), *v);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl clap::Args for ParamArgs {
+    fn augment_args(mut cmd: clap::Command) -> clap::Command {
+        for p in all_params() {
+            cmd = cmd.arg(
+                clap::Arg::new(p.name())
+                    .long(p.name())
+                    .value_name(p.value_name())
+                    .help(help_text(p))
+                    .help_heading("Method parameters")
+                    .allow_negative_numbers(true)
+                    .value_parser(move |text: &str| p.parse(text)),
+            );
+        }
+        cmd
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::{Args as _, FromArgMatches as _};
+
+    fn parse(args: &[&str]) -> Result<ParamArgs, clap::Error> {
+        let cmd = ParamArgs::augment_args(clap::Command::new("t").no_binary_name(true));
+        ParamArgs::from_arg_matches(&cmd.try_get_matches_from(args)?)
+    }
+
+    #[test]
+    fn every_parameter_is_an_option_and_only_given_ones_are_kept() {
+        let p = parse(&["--tau", "0.2", "--stencil", "off", "--upsample", "nearest"]).unwrap();
+        assert_eq!(p.0.get("tau"), Some(Value::Real(0.2)));
+        assert_eq!(p.0.get("stencil"), Some(Value::Switch(false)));
+        assert_eq!(p.0.get("upsample"), Some(Value::Choice(1)));
+        assert_eq!(p.0 .0.len(), 3);
+        // Out of range parses (the range is checked with the settings); a
+        // wrong type does not.
+        assert!(parse(&["--tau", "-1"]).is_ok());
+        assert!(parse(&["--vpls", "many"]).is_err());
+        assert!(parse(&["--upsample", "cubic"]).is_err());
+        let names: Vec<&str> = all_params().iter().map(|p| p.name()).collect();
+        for n in [
+            "vpls",
+            "tau",
+            "levels",
+            "isr-base",
+            "splat-threshold",
+            "reference-chunk",
+        ] {
+            assert!(names.contains(&n), "{n}");
+        }
+    }
+}
