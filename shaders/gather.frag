@@ -73,9 +73,9 @@ void patch_list(vec3 xi, vec3 ni) {
 // gives its form: C <= 2 I |V_j|^2 / (3 R^2 |V_ij|^2 + 2 |V_j|^2). Requiring
 // it to exceed tau:
 //   subdivide j  iff  |V_ij|^2 <= T |V_j|^2,  T = 2 (I - tau) / (3 tau R^2),
-// constant per run (run.hisr_threshold; `--tau` is tau / I, so the host's
-// `hisr::subdivision_threshold` computes T = 2 (1 - tau) / (3 tau R^2), the
-// one place it is evaluated). The per-level factor: a patch k levels above the finest stands
+// constant per run (run.hisr_threshold; `--tau` is tau / I, so the host
+// computes T = 2 (1 - tau) / (3 tau R^2), in the one place it is evaluated).
+// The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
 // R^2 / 4^k and its threshold 4^k T. For cube faces and orthographic RSMs
 // the right-hand side differs: hisr_bound in light_types.glsl derives it.

@@ -39,40 +39,40 @@ const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 
 // What is fixed for a run: sizes, thresholds, levels (std140 uniform block,
 // set 0 binding 1, written once). Each group is filled by the module that
-// owns its parameters (named after the group), from the one function that
-// derives each value.
+// owns its parameters (src/gpu_types.rs names it), from the one function
+// that derives each value.
 struct RunUniforms {
-    // Shadows of the direct light (frame/uniforms.rs, RenderSettings).
+    // Shadows of the direct light.
     float shadow_normal_offset;   // RSM texels at the receiver
     float shadow_depth_bias;      // constant, relative to the distance to the light
     float pcf_radius;             // PCF tap spacing (RSM texels)
     float shadow_slope_bias;      // RSM texels along the receiver's slope
-    // Sizes (frame/uniforms.rs).
+    // Sizes.
     uvec2 output_size;            // width, height (pixels)
     uint rsm_resolution;          // R
     int rsm_top_level;            // log2 R: the RSM quadtree's root (one patch)
     float exposure;               // multiplier applied before the PNG's sRGB encoding
-    // The eye-space hierarchy (multires/mod.rs, docs/algorithm.md section 3).
+    // The eye-space hierarchy (docs/algorithm.md section 3).
     int levels;                   // coarsest level L
     float depth_threshold;        // relative view-depth range, (max - min) / min
     float normal_chord;           // normal threshold as the chord |n_max - n_min| of
                                   // the normals' component box, 2 sin(angle / 2)
     int hierarchy_flags;          // HIERARCHY_*
-    // The regular VPLs (methods/vpls.rs): level vpl_level of the RSM quadtree,
-    // vpl_side x vpl_side of them.
+    // The regular VPLs: level vpl_level of the RSM quadtree, vpl_side x
+    // vpl_side of them.
     int vpl_level;
     int vpl_side;
-    // Patch validity in the RSM quadtree (passes/rsm_tree.rs, docs/algorithm.md section 4).
+    // Patch validity in the RSM quadtree (docs/algorithm.md section 4).
     float validity_depth;         // relative to the distance to the light
     float validity_normal_cos;    // cosine of the angle threshold
-    // Basic ISR (methods/isr.rs).
+    // Basic ISR.
     int isr_base_level;           // RSM quadtree level (mip) of the base
-    // HISR (methods/hisr.rs, docs/algorithm.md section 4.3).
-    float hisr_threshold;         // T at the finest level (hisr::subdivision_threshold;
-                                  // gather.frag derives the test)
+    // HISR (docs/algorithm.md section 4.3).
+    float hisr_threshold;         // T at the finest level, computed once on the host
+                                  // (gather.frag derives the test)
     int hisr_start_depth;         // traversal starts from 2^s x 2^s patches
     int hisr_max_depth;           // and subdivides down to 2^d x 2^d
-    // Restricted splats (methods/rsm_splat.rs).
+    // Restricted splats.
     float splat_threshold;        // irradiance bound, W/m^2
     int pad0;
     int pad1;

@@ -44,7 +44,7 @@ impl GatherPass {
         source: LightPatches,
         light: &dyn LightSpacePass,
     ) -> Result<Self> {
-        let patches = light.buffer();
+        let patches = light.patch_buffer();
         // Bound in every case (the shader declares it); read only when tiled.
         let cuts = match source {
             LightPatches::TiledTraversal => light

@@ -128,7 +128,7 @@ impl Descriptor for HisrMethod {
         l
     }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
-        Ok(Box::new(new(setup)?))
+        Ok(Box::new(make(setup)?))
     }
 }
 
@@ -177,7 +177,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
 /// copies the RSM quadtree's nodes down to the max depth into one buffer, root
 /// first; with tiles (`--hisr-tile-level`), pass `hisr-cut` finds each
 /// eye-space tile's shared cut; then the gather traverses per fragment.
-fn new(setup: &Setup) -> Result<MultiresMethod> {
+fn make(setup: &Setup) -> Result<MultiresMethod> {
     let nodes = packed_nodes(setup.settings);
     // One invocation per node: 2^max_depth wide, enough rows for every node.
     let width = 1u64 << MAX_DEPTH.get(setup.settings);
@@ -194,7 +194,7 @@ fn new(setup: &Setup) -> Result<MultiresMethod> {
     )?;
     let cut = match TILE_LEVEL.get(setup.settings) {
         0 => None,
-        _ => Some(CutPass::new(setup, pack.buffer())?),
+        _ => Some(CutPass::new(setup, pack.patch_buffer())?),
     };
     let source = match cut {
         Some(_) => LightPatches::TiledTraversal,
@@ -230,8 +230,8 @@ impl LightSpacePass for HisrLightPass {
         }
     }
 
-    fn buffer(&self) -> &Buffer {
-        self.pack.buffer()
+    fn patch_buffer(&self) -> &Buffer {
+        self.pack.patch_buffer()
     }
 
     fn packed_tree(&self) -> Option<&Buffer> {

@@ -30,7 +30,7 @@ pub trait FillPass {
 /// `ChosenPatches`.
 pub trait LightSpacePass {
     fn record(&self, ctx: &FrameContext, profiler: &mut Profiler);
-    fn buffer(&self) -> &Buffer;
+    fn patch_buffer(&self) -> &Buffer;
     /// Basic ISR's chosen list (read back for `--stats` and tests).
     fn chosen_list(&self) -> Option<&Buffer> {
         None
@@ -107,7 +107,7 @@ impl PatchListPass {
 }
 
 impl LightSpacePass for PatchListPass {
-    fn buffer(&self) -> &Buffer {
+    fn patch_buffer(&self) -> &Buffer {
         &self.buffer
     }
 
