@@ -23,17 +23,15 @@ pub fn register_font() {
     });
 }
 
-/// A fixed colour per method, the same in every chart.
+/// A fixed colour per method, the same in every chart
+/// (`methods::Descriptor::color`); black for a name no method has.
 pub fn method_color(method: &str) -> RGBColor {
-    match method {
-        "rsm-gather" => RGBColor(120, 120, 120),
-        "rsm-splat" => RGBColor(140, 86, 75),
-        "rsm-splat-restricted" => RGBColor(227, 119, 194),
-        "multires-splat" => RGBColor(255, 127, 14),
-        "multires-gather" => RGBColor(31, 119, 180),
-        "isr" => RGBColor(44, 160, 44),
-        "hisr" => RGBColor(214, 39, 40),
-        _ => RGBColor(0, 0, 0),
+    match crate::methods::by_name(method) {
+        Ok(d) => {
+            let [r, g, b] = d.color();
+            RGBColor(r, g, b)
+        }
+        Err(_) => RGBColor(0, 0, 0),
     }
 }
 

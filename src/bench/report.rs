@@ -16,13 +16,16 @@ pub struct Ratio {
     pub detail: String,
 }
 
-const REGULAR: &[&str] = &[
-    "rsm-gather",
-    "rsm-splat",
-    "rsm-splat-restricted",
-    "multires-splat",
-    "multires-gather",
-];
+/// The methods that take N regular VPLs (`--vpls`), in registry order.
+fn regular() -> Vec<&'static str> {
+    crate::methods::REGISTRY
+        .iter()
+        .filter(|&&d| {
+            crate::methods::params_of(d).any(|p| p.name() == crate::methods::vpls::VPLS.name)
+        })
+        .map(|d| d.key().name())
+        .collect()
+}
 
 fn find<'a>(rows: &'a [Row], scene: &str, method: &str, vpls: u32) -> Option<&'a Row> {
     rows.iter().find(|r| {
@@ -82,10 +85,10 @@ pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
                 detail,
             })
         };
-        for (base, n) in REGULAR
-            .iter()
+        for (base, n) in regular()
+            .into_iter()
             .map(|b| (b, 256))
-            .chain([(&"multires-gather", 4096)])
+            .chain([("multires-gather", 4096)])
         {
             let Some(b) = find(rows, s, base, n) else {
                 continue;
@@ -155,9 +158,7 @@ fn hisr_front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
     let mut least: Option<(f64, &Row, &Row)> = None;
     let (mut reached, mut unreached) = (0, 0);
     let others = rows.iter().filter(|r| {
-        r.scene == scene
-            && r.indirect_ms.is_some()
-            && (REGULAR.contains(&r.method.as_str()) || r.method == "isr")
+        r.scene == scene && r.indirect_ms.is_some() && r.method != "hisr" && r.method != "reference"
     });
     for b in others {
         let Some(h) = fastest_at_most(rows, scene, "hisr", b.rel_rmse_indirect) else {

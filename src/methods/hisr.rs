@@ -86,6 +86,9 @@ impl Descriptor for HisrMethod {
     fn key(&self) -> Method {
         KEY
     }
+    fn color(&self) -> [u8; 3] {
+        [214, 39, 40]
+    }
     fn help(&self) -> &'static str {
         "Hierarchical ISR: a per-fragment traversal of the RSM quadtree."
     }

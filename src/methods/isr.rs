@@ -46,6 +46,9 @@ impl Descriptor for IsrMethod {
     fn key(&self) -> Method {
         KEY
     }
+    fn color(&self) -> [u8; 3] {
+        [44, 160, 44]
+    }
     fn help(&self) -> &'static str {
         "Basic ISR: per-frame clustered light patches, gathered by every eye patch."
     }

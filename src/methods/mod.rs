@@ -105,6 +105,24 @@ pub trait Descriptor: Sync {
         self.key().name().into()
     }
 
+    /// Its colour in the bench's charts (sRGB). By default one of a fixed
+    /// palette, by its place in the registry.
+    fn color(&self) -> [u8; 3] {
+        const PALETTE: [[u8; 3]; 6] = [
+            [148, 103, 189],
+            [23, 190, 207],
+            [188, 189, 34],
+            [127, 127, 127],
+            [255, 152, 150],
+            [197, 176, 213],
+        ];
+        let i = REGISTRY
+            .iter()
+            .position(|d| d.key() == self.key())
+            .unwrap_or(0);
+        PALETTE[i % PALETTE.len()]
+    }
+
     /// Light patches evaluated per pixel with geometry, where that is fixed
     /// (the full-resolution methods that evaluate every VPL everywhere);
     /// the multiresolution methods count theirs on the GPU.

@@ -25,6 +25,9 @@ impl Descriptor for MultiresGatherMethod {
     fn key(&self) -> Method {
         KEY
     }
+    fn color(&self) -> [u8; 3] {
+        [31, 119, 180]
+    }
     fn help(&self) -> &'static str {
         "Stenciled gathering from N regular VPLs into the multiresolution buffer."
     }

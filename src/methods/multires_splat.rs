@@ -29,6 +29,9 @@ impl Descriptor for MultiresSplatMethod {
     fn key(&self) -> Method {
         KEY
     }
+    fn color(&self) -> [u8; 3] {
+        [255, 127, 14]
+    }
     fn help(&self) -> &'static str {
         "Each VPL splats into every patch of the multiresolution buffer."
     }

@@ -22,6 +22,9 @@ impl Descriptor for RsmGatherMethod {
     fn key(&self) -> Method {
         KEY
     }
+    fn color(&self) -> [u8; 3] {
+        [120, 120, 120]
+    }
     fn help(&self) -> &'static str {
         "Every full-resolution pixel gathers N regular VPLs."
     }

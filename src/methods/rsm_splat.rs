@@ -47,6 +47,12 @@ impl Descriptor for RsmSplatMethod {
             true => Method::new("rsm-splat-restricted"),
         }
     }
+    fn color(&self) -> [u8; 3] {
+        match self.restricted {
+            false => [140, 86, 75],
+            true => [227, 119, 194],
+        }
+    }
     fn help(&self) -> &'static str {
         match self.restricted {
             false => "Each VPL splats a full-screen quad, additively.",
