@@ -102,7 +102,7 @@ impl TargetDesc {
     /// Mip levels: RSM color images hold the whole quadtree.
     pub fn mips(&self, s: &RenderSettings) -> u32 {
         if self.at_rsm_resolution && self.format != DEPTH_FORMAT {
-            s.rsm_resolution.ilog2() + 1
+            s.rsm_top_level() + 1
         } else {
             1
         }

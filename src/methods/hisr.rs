@@ -154,8 +154,12 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     if quick {
         return v;
     }
-    let deepest = 6.min(rsm.ilog2());
-    let start = START_LEVEL.default_in(&RenderSettings::DEFAULT);
+    let at_rsm = RenderSettings {
+        rsm_resolution: rsm,
+        ..RenderSettings::DEFAULT
+    };
+    let deepest = MAX_DEPTH.default_in(&at_rsm);
+    let start = START_LEVEL.default_in(&at_rsm);
     for t in [0.97, 0.9] {
         for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
             if d >= start {
@@ -168,7 +172,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     }
     // The accurate end: one level deeper (single RSM texels at RSM 128),
     // where the default depth stops near the error of 4^6 = 4096 VPLs.
-    if rsm.ilog2() > deepest {
+    if at_rsm.rsm_top_level() > deepest {
         for t in [0.2, 0.1, 0.05, 0.01] {
             v.push(tau(t).with(&MAX_DEPTH, deepest + 1));
         }

@@ -116,7 +116,7 @@ pub fn check(s: &RenderSettings, method: &str) -> Result<()> {
         bail!(
             "resolution {}x{}: method {method} needs at least 2x2 pixels (its multiresolution buffer's \
              coarsest level halves the image at least once); use a larger --width/--height, or a \
-             method without that buffer (rsm-gather, rsm-splat, reference)",
+             full-resolution method (`isr render --help` says which methods read --levels)",
             s.width,
             s.height,
         );

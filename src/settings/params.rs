@@ -412,29 +412,15 @@ impl<T: ParamType + Sync> AnyParam for Param<T> {
         let v = self.get(s);
         if !self.accepts(v) {
             bail!(
-                "--{} {}: {} must be {}",
+                "--{} {}: must be {} ({})",
                 self.name,
                 v.text(),
-                first_sentence(self.help),
-                self.range.describe()
+                self.range.describe(),
+                self.help
             );
         }
         Ok(())
     }
-}
-
-/// The help's first clause, lower-cased at its start, for error messages.
-fn first_sentence(help: &str) -> String {
-    let end = help.find([':', '.', ';']).unwrap_or(help.len());
-    let mut s = help[..end].to_string();
-    // "Split a texel" -> "split a texel"; "HISR's" stays.
-    let first_word = s.chars().take_while(|c| c.is_alphanumeric());
-    let acronym = first_word.filter(|c| c.is_uppercase()).count() > 1;
-    if !acronym && s.is_char_boundary(1) {
-        let lower = s[..1].to_lowercase();
-        s.replace_range(..1, &lower);
-    }
-    s
 }
 
 /// The parameter values a run sets, by name (unset ones take their default).
@@ -507,7 +493,7 @@ mod tests {
         let e = P.check(&s).unwrap_err().to_string();
         assert_eq!(
             e,
-            "--test-count 3: a count must be a power of 2 from 1 to 64"
+            "--test-count 3: must be a power of 2 from 1 to 64 (A count: for the test.)"
         );
         assert_eq!(P.parse("16"), Ok(Value::Count(16)));
         assert!(P.parse("x").is_err() && P.parse("-1").is_err());

@@ -43,6 +43,9 @@ fn shader_module(gpu: &Gpu, name: &str) -> Result<vk::ShaderModule> {
 thread_local! {
     /// Test hook: pipelines this thread may still create before one fails.
     static PIPELINES_BEFORE_FAILURE: std::cell::Cell<Option<u32>> = const { std::cell::Cell::new(None) };
+    /// Test hook: pipelines this thread has gone on to create (see
+    /// [`pipelines_created`]).
+    static PIPELINES_CREATED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// Makes the pipeline creation after the next `n` on this thread fail, so a
@@ -51,6 +54,15 @@ thread_local! {
 #[doc(hidden)]
 pub fn fail_pipeline_creation_after(n: Option<u32>) {
     PIPELINES_BEFORE_FAILURE.with(|c| c.set(n));
+}
+
+/// How many pipelines this thread has gone on to create so far: every one
+/// [`fail_pipeline_creation_after`] counts and did not fail. A test takes the
+/// difference over a setup that succeeded to know how many pipelines it
+/// makes, so that it can make each of them fail in turn.
+#[doc(hidden)]
+pub fn pipelines_created() -> u64 {
+    PIPELINES_CREATED.with(|c| c.get())
 }
 
 fn injected_failure(name: &str) -> Result<()> {
@@ -64,7 +76,9 @@ fn injected_failure(name: &str) -> Result<()> {
             Ok(())
         }
         None => Ok(()),
-    })
+    })?;
+    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
+    Ok(())
 }
 
 /// glTF front faces are counter-clockwise seen from the front. Vulkan's
