@@ -93,13 +93,12 @@ impl Descriptor for HisrMethod {
         "Hierarchical ISR: a per-fragment traversal of the RSM quadtree."
     }
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
-        &[multires::PARAMS, rsm_tree::PARAMS, PARAMS]
+        &[rsm_tree::PARAMS, PARAMS]
     }
     fn uses_multires(&self) -> bool {
         true
     }
     fn check(&self, s: &RenderSettings) -> Result<()> {
-        multires::check(s, KEY.name())?;
         let top = s.rsm_top_level();
         let (start, max) = (START_LEVEL.get(s), MAX_DEPTH.get(s));
         if max > top || start > max {
@@ -109,12 +108,12 @@ impl Descriptor for HisrMethod {
         }
         Ok(())
     }
+    /// The packed tree and the tile cuts.
     fn memory(&self, s: &RenderSettings) -> u64 {
         let node = std::mem::size_of::<LightPatch>() as u64;
-        multires::memory(s) + packed_nodes(s) * node + cut_bytes(s)
+        packed_nodes(s) * node + cut_bytes(s)
     }
     fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        multires::write_uniforms(s, u);
         u.hisr_threshold = subdivision_threshold(TAU.get(s), s.rsm_resolution);
         u.hisr_start_depth = START_LEVEL.get(s) as i32;
         u.hisr_max_depth = MAX_DEPTH.get(s) as i32;

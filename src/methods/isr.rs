@@ -12,7 +12,6 @@ use super::multires_method::{MultiresMethod, PatchList, PatchListPass};
 use super::{Descriptor, IndirectMethod};
 use crate::frame::Setup;
 use crate::gpu_types::{LightPatch, RunUniforms};
-use crate::multires;
 use crate::passes::rsm_tree;
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
@@ -53,24 +52,23 @@ impl Descriptor for IsrMethod {
         "Basic ISR: per-frame clustered light patches, gathered by every eye patch."
     }
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
-        &[multires::PARAMS, rsm_tree::PARAMS, PARAMS]
+        &[rsm_tree::PARAMS, PARAMS]
     }
     fn uses_multires(&self) -> bool {
         true
     }
     fn check(&self, s: &RenderSettings) -> Result<()> {
-        multires::check(s, KEY.name())?;
         let (base, r) = (BASE.get(s), s.rsm_resolution);
         if base > r {
             bail!("--isr-base {base}: the base must be a power of 2 no larger than --rsm {r}");
         }
         Ok(())
     }
+    /// The chosen list: at most one patch per base texel.
     fn memory(&self, s: &RenderSettings) -> u64 {
-        multires::memory(s) + base_texels(s) * std::mem::size_of::<LightPatch>() as u64
+        base_texels(s) * std::mem::size_of::<LightPatch>() as u64
     }
     fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        multires::write_uniforms(s, u);
         u.isr_base_level = base_level(s) as i32;
     }
     fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {

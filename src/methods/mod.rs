@@ -27,7 +27,7 @@ pub mod vpls;
 
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
-use crate::multires::MultiresBuffer;
+use crate::multires::{self, MultiresBuffer};
 use crate::settings::params::AnyParam;
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
@@ -59,15 +59,25 @@ pub trait Descriptor: Sync {
     /// One sentence for `--help` and the README.
     fn help(&self) -> &'static str;
 
-    /// The parameters it reads, in groups (the shared ones first): each is a
-    /// `--NAME` option and is checked against its range before a run.
+    /// The parameters it reads besides those its capabilities bring (below),
+    /// in groups: each is a `--NAME` option and is checked against its range
+    /// before a run.
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
         &[]
     }
 
     /// Whether it works through the multiresolution buffer (its
-    /// `IndirectMethod::multires` is then the buffer).
+    /// `IndirectMethod::multires` is then the buffer). The buffer's
+    /// parameters, checks, memory and uniforms then come with it
+    /// (`multires::PARAMS`, `multires::check`, ...).
     fn uses_multires(&self) -> bool {
+        false
+    }
+
+    /// Whether it reads the N regular VPLs of `--vpls`: their parameters,
+    /// check and uniforms then come with it (`vpls`), and its bench sweep
+    /// and label default to the VPL count's.
+    fn reads_regular_vpls(&self) -> bool {
         false
     }
 
@@ -77,32 +87,38 @@ pub trait Descriptor: Sync {
         true
     }
 
-    /// Checks across its parameters and the sizes; each parameter's own
-    /// range is checked before (`check`).
+    /// Checks across its own parameters and the sizes; each parameter's
+    /// range and its capabilities' checks run before (`check`).
     fn check(&self, _s: &RenderSettings) -> Result<()> {
         Ok(())
     }
 
-    /// Bytes of GPU memory its own resources take, for the check before
-    /// anything is allocated.
+    /// Bytes of GPU memory its own resources take, besides its
+    /// capabilities' (`memory`), for the check before anything is allocated.
     fn memory(&self, _s: &RenderSettings) -> u64 {
         0
     }
 
-    /// Writes its fields of the run uniforms (the shared ones are written
-    /// before).
+    /// Writes its own fields of the run uniforms (the shared ones and its
+    /// capabilities' are written before, `write_uniforms`).
     fn write_uniforms(&self, _s: &RenderSettings, _u: &mut RunUniforms) {}
 
     /// The bench's sweep over its parameters for RSM resolution `rsm`: each
     /// point the values it sets; `quick` keeps two or three. Empty: the
     /// bench does not sweep it. One point sets nothing or only defaults.
-    fn sweep(&self, _rsm: u32, _quick: bool) -> Vec<Params> {
-        vec![]
+    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
+        match self.reads_regular_vpls() {
+            true => vpls::sweep(rsm, quick),
+            false => vec![],
+        }
     }
 
     /// A short label for tables and charts: "256 VPLs", "tau 0.05, depth 6".
-    fn label(&self, _s: &RenderSettings) -> String {
-        self.key().name().into()
+    fn label(&self, s: &RenderSettings) -> String {
+        match self.reads_regular_vpls() {
+            true => vpls::label(s),
+            false => self.key().name().into(),
+        }
     }
 
     /// Its colour in the bench's charts (sRGB). By default one of a fixed
@@ -167,9 +183,43 @@ pub fn names() -> Vec<&'static str> {
     REGISTRY.iter().map(|d| d.key().name()).collect()
 }
 
-/// Every parameter of `d`.
+/// Every parameter of `d`: its capabilities' (the multiresolution buffer's,
+/// the regular VPLs'), then its own.
 pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyParam> {
-    d.params().iter().flat_map(|g| g.iter().copied())
+    let multires: &[&dyn AnyParam] = if d.uses_multires() {
+        multires::PARAMS
+    } else {
+        &[]
+    };
+    let regular: &[&dyn AnyParam] = if d.reads_regular_vpls() {
+        vpls::PARAMS
+    } else {
+        &[]
+    };
+    let own = d.params().iter().flat_map(|g| g.iter().copied());
+    multires.iter().chain(regular).copied().chain(own)
+}
+
+/// Bytes of GPU memory `d`'s resources take for `s`, its capabilities' included.
+pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
+    let multires = if d.uses_multires() {
+        multires::memory(s)
+    } else {
+        0
+    };
+    multires + d.memory(s)
+}
+
+/// Writes `d`'s fields of the run uniforms for `s`: its capabilities', then
+/// its own.
+pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniforms) {
+    if d.uses_multires() {
+        multires::write_uniforms(s, u);
+    }
+    if d.reads_regular_vpls() {
+        vpls::RegularVpls::of(s).write_uniforms(s, u);
+    }
+    d.write_uniforms(s, u);
 }
 
 /// Every parameter of every method, once each, in registry order.
@@ -195,6 +245,12 @@ pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
         if p.is_set_in(s) || params_of(d).any(|q| q.name() == p.name()) {
             p.check(s)?;
         }
+    }
+    if d.uses_multires() {
+        multires::check(s, d.key().name())?;
+    }
+    if d.reads_regular_vpls() {
+        vpls::check(s)?;
     }
     d.check(s)?;
     Ok(d)

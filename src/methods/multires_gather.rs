@@ -7,13 +7,11 @@
 
 use super::gather::{GatherPass, LightPatches};
 use super::multires_method::{MultiresMethod, PatchList, PatchListPass};
-use super::vpls::{self, RegularVpls};
+use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::Setup;
-use crate::gpu_types::{LightPatch, RunUniforms};
-use crate::multires;
-use crate::settings::params::AnyParam;
-use crate::settings::{Method, Params, RenderSettings};
+use crate::gpu_types::LightPatch;
+use crate::settings::{Method, RenderSettings};
 use anyhow::{anyhow, Result};
 use ash::vk;
 
@@ -31,29 +29,15 @@ impl Descriptor for MultiresGatherMethod {
     fn help(&self) -> &'static str {
         "Stenciled gathering from N regular VPLs into the multiresolution buffer."
     }
-    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
-        &[multires::PARAMS, vpls::PARAMS]
-    }
     fn uses_multires(&self) -> bool {
         true
     }
-    fn check(&self, s: &RenderSettings) -> Result<()> {
-        multires::check(s, KEY.name())?;
-        vpls::check(s)
+    fn reads_regular_vpls(&self) -> bool {
+        true
     }
+    /// The VPL list.
     fn memory(&self, s: &RenderSettings) -> u64 {
-        let list = RegularVpls::of(s).count as u64 * std::mem::size_of::<LightPatch>() as u64;
-        multires::memory(s) + list
-    }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        multires::write_uniforms(s, u);
-        RegularVpls::of(s).write_uniforms(s, u);
-    }
-    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
-        vpls::sweep(rsm, quick)
-    }
-    fn label(&self, s: &RenderSettings) -> String {
-        vpls::label(s)
+        RegularVpls::of(s).count as u64 * std::mem::size_of::<LightPatch>() as u64
     }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
         let v = RegularVpls::of(setup.settings);

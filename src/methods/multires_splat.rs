@@ -9,14 +9,12 @@
 
 use super::multires_method::{FillPass, MultiresMethod};
 use super::rsm_splat::require_blending;
-use super::vpls::{self, RegularVpls};
+use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::RunUniforms;
 use crate::multires::{self, MultiresBuffer};
 use crate::passes::INDIRECT_GRAPHICS;
-use crate::settings::params::AnyParam;
-use crate::settings::{Method, Params, RenderSettings};
+use crate::settings::{Method, RenderSettings};
 use crate::vk::pipeline::{Binding, Blend, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
 use anyhow::{bail, Result};
@@ -35,31 +33,17 @@ impl Descriptor for MultiresSplatMethod {
     fn help(&self) -> &'static str {
         "Each VPL splats into every patch of the multiresolution buffer."
     }
-    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
-        &[multires::PARAMS, vpls::PARAMS]
-    }
     fn uses_multires(&self) -> bool {
+        true
+    }
+    fn reads_regular_vpls(&self) -> bool {
         true
     }
     fn check(&self, s: &RenderSettings) -> Result<()> {
         if !multires::STENCIL.get(s) {
             bail!("--stencil off measures the stenciled gathers; multires-splat always splats through the stencil");
         }
-        multires::check(s, KEY.name())?;
-        vpls::check(s)
-    }
-    fn memory(&self, s: &RenderSettings) -> u64 {
-        multires::memory(s)
-    }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        multires::write_uniforms(s, u);
-        RegularVpls::of(s).write_uniforms(s, u);
-    }
-    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
-        vpls::sweep(rsm, quick)
-    }
-    fn label(&self, s: &RenderSettings) -> String {
-        vpls::label(s)
+        Ok(())
     }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
         let method = MultiresMethod::new(setup, None, |setup, m, _| {

@@ -3,13 +3,11 @@
 //! `rsm-gather`, `shaders/rsm_gather.frag` (barriers: `FullscreenPass::record`).
 //! Reads the G-buffer and the RSM quadtree; writes `indirect`.
 
-use super::vpls::{self, RegularVpls};
+use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::RunUniforms;
 use crate::passes::{push_bytes, FullscreenPass, INDIRECT_GRAPHICS};
-use crate::settings::params::AnyParam;
-use crate::settings::{Method, Params, RenderSettings};
+use crate::settings::{Method, RenderSettings};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
@@ -28,20 +26,8 @@ impl Descriptor for RsmGatherMethod {
     fn help(&self) -> &'static str {
         "Every full-resolution pixel gathers N regular VPLs."
     }
-    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
-        &[vpls::PARAMS]
-    }
-    fn check(&self, s: &RenderSettings) -> Result<()> {
-        vpls::check(s)
-    }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        RegularVpls::of(s).write_uniforms(s, u);
-    }
-    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
-        vpls::sweep(rsm, quick)
-    }
-    fn label(&self, s: &RenderSettings) -> String {
-        vpls::label(s)
+    fn reads_regular_vpls(&self) -> bool {
+        true
     }
     fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
         Some(RegularVpls::of(s).count as u64)

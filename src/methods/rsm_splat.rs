@@ -7,13 +7,13 @@
 //! writes `indirect` (barriers below).
 
 use super::rsm_gather::full_resolution_bindings;
-use super::vpls::{self, RegularVpls};
+use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, Attachments, INDIRECT_GRAPHICS};
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
-use crate::settings::{Method, Params, RenderSettings};
+use crate::settings::{Method, RenderSettings};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
@@ -59,26 +59,19 @@ impl Descriptor for RsmSplatMethod {
             true => "Each VPL splats a quad bounded to where it can exceed --splat-threshold.",
         }
     }
+    fn reads_regular_vpls(&self) -> bool {
+        true
+    }
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
         match self.restricted {
-            false => &[vpls::PARAMS],
-            true => &[vpls::PARAMS, RESTRICTED_PARAMS],
+            false => &[],
+            true => &[RESTRICTED_PARAMS],
         }
     }
-    fn check(&self, s: &RenderSettings) -> Result<()> {
-        vpls::check(s)
-    }
     fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        RegularVpls::of(s).write_uniforms(s, u);
         if self.restricted {
             u.splat_threshold = THRESHOLD.get(s);
         }
-    }
-    fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
-        vpls::sweep(rsm, quick)
-    }
-    fn label(&self, s: &RenderSettings) -> String {
-        vpls::label(s)
     }
     /// Full-screen splats evaluate every VPL at every pixel; restricted ones
     /// fewer, uncounted.

@@ -583,7 +583,7 @@ fn check_run(
 ) -> Result<&'static dyn Descriptor> {
     check_ranges(settings)?;
     let d = crate::methods::check(settings)?;
-    let method = d.memory(settings);
+    let method = crate::methods::memory(d, settings);
     check_settings(gpu, settings, method)?;
     let cube_rsm = match lights.iter().any(|l| l.kind == LightKind::Point) {
         true => crate::passes::rsm_cube::cube_bytes(settings.rsm_resolution),
@@ -604,7 +604,7 @@ fn check_run(
 fn run_uniforms(d: &dyn Descriptor, s: &RenderSettings) -> RunUniforms {
     let mut u = crate::frame::uniforms::run_uniforms(s);
     rsm_tree::write_uniforms(s, &mut u);
-    d.write_uniforms(s, &mut u);
+    crate::methods::write_uniforms(d, s, &mut u);
     u
 }
 
