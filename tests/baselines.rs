@@ -11,11 +11,8 @@ use isr::settings::{Method, RenderSettings};
 
 fn settings(method: Method) -> RenderSettings {
     RenderSettings {
-        width: 96,
-        height: 80,
-        rsm_resolution: 64,
         method,
-        ..Default::default()
+        ..sized("none", 96, 80, 64)
     }
     .with(&VPLS, 64)
 }

@@ -1,21 +1,14 @@
 //! `isr bench`: the quick sweep (the CI smoke test) writes every output with
 //! finite numbers and resumes from its journal; bad input is a clear error.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("isr-bench-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
+use common::cli::{Isr, Ran};
+use common::temp_dir;
+use std::path::Path;
 
-fn bench(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_isr"))
-        .arg("bench")
-        .args(args)
-        .output()
-        .expect("isr runs")
+fn bench(args: &[&str]) -> Ran {
+    Isr::new("bench").args(args).run()
 }
 
 /// Every number anywhere in the JSON value.
@@ -34,14 +27,11 @@ fn lines(p: &Path) -> usize {
 
 #[test]
 fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
-    let dir = temp_dir("quick");
+    let dir = temp_dir("bench-quick");
     let d = dir.to_str().unwrap();
-    let out = bench(&["--quick", "--out-dir", d]);
-    assert!(
-        out.status.success(),
-        "isr bench --quick failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    Isr::new("bench")
+        .args(["--quick", "--out-dir", d])
+        .succeeds();
     for f in [
         "results.json",
         "results.csv",
@@ -88,48 +78,44 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     // A second run finds every row in the journal and renders nothing.
     let journal = dir.join("rows.jsonl");
     let before = lines(&journal);
-    let again = bench(&["--quick", "--out-dir", d]);
-    assert!(again.status.success());
+    Isr::new("bench")
+        .args(["--quick", "--out-dir", d])
+        .succeeds();
     assert_eq!(lines(&journal), before);
     // An interrupted run: drop the last rows; the rerun renders only those.
     let text = std::fs::read_to_string(&journal).unwrap();
     let kept: Vec<&str> = text.lines().take(before - 3).collect();
     std::fs::write(&journal, kept.join("\n") + "\n").unwrap();
-    let resumed = bench(&["--quick", "--out-dir", d, "--scenes", "slats"]);
-    assert!(resumed.status.success());
+    Isr::new("bench")
+        .args(["--quick", "--out-dir", d, "--scenes", "slats"])
+        .succeeds();
     assert_eq!(lines(&journal), before);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bad_names_list_the_valid_ones() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("bench-bad");
     let d = dir.to_str().unwrap();
-    let out = bench(&["--quick", "--out-dir", d, "--scenes", "atrium"]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let fails =
+        |args: &[&str]| bench(&[&["--quick", "--out-dir", d], args].concat()).clean_failure();
+    let err = fails(&["--scenes", "atrium"]);
     assert!(
         err.contains("unknown scene 'atrium'") && err.contains("cornell, fine, hall"),
         "{err}"
     );
-    let out = bench(&["--quick", "--out-dir", d, "--methods", "hisr,magic"]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = fails(&["--methods", "hisr,magic"]);
     assert!(
         err.contains("magic") && err.contains("multires-gather"),
         "{err}"
     );
-    let out = bench(&["--quick", "--out-dir", d, "--methods", "reference"]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = fails(&["--methods", "reference"]);
     assert!(
         err.contains("has no sweep") && err.contains("hisr"),
         "{err}"
     );
-    let out = bench(&["--quick", "--out-dir", d, "--rsm", "100"]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("power of two"));
-    // Nothing was rendered, and no panic (exit status 101).
-    assert_eq!(out.status.code(), Some(1));
+    // Nothing was rendered, and no panic (exit status 1, `clean_failure`).
+    let err = fails(&["--rsm", "100"]);
+    assert!(err.contains("power of two"), "{err}");
     assert!(!dir.join("rows.jsonl").exists());
 }

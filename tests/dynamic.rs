@@ -2,19 +2,14 @@
 //! posed at each time, with nothing of the indirect light kept between frames.
 mod common;
 
+use common::cli::Isr;
 use common::*;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
-use isr::settings::{Method, RenderSettings};
+use isr::settings::RenderSettings;
 
 fn settings() -> RenderSettings {
-    RenderSettings {
-        width: 64,
-        height: 64,
-        rsm_resolution: 64,
-        method: Method::new("hisr"),
-        ..Default::default()
-    }
+    sized("hisr", 64, 64, 64)
 }
 
 /// A frame rendered after others equals the same time rendered alone, and
@@ -267,27 +262,15 @@ fn a_moving_camera_changes_the_image() {
 /// the GIF, and a frame equal to its time rendered alone by `--time`.
 #[test]
 fn the_sequence_command_writes_frames_timings_and_a_gif() {
-    let dir = std::env::temp_dir().join(format!("isr-sequence-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let common = [
-        "render",
-        "--method",
-        "hisr",
-        "--width",
-        "48",
-        "--height",
-        "32",
-        "--rsm",
-        "64",
-        "--validate",
-    ];
+    let dir = temp_dir("sequence");
     let run = |extra: &[&str]| {
-        let out = bin().args(common).args(extra).output().unwrap();
-        assert!(
-            out.status.success(),
-            "isr {extra:?} failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        Isr::render(&dir)
+            .args([
+                "--method", "hisr", "--width", "48", "--height", "32", "--rsm", "64",
+            ])
+            .arg("--validate")
+            .args(extra)
+            .succeeds()
     };
     let seq = dir.join("seq");
     run(&[
@@ -299,11 +282,8 @@ fn the_sequence_command_writes_frames_timings_and_a_gif() {
         "2",
         "--gif",
         "--sequence",
-    ]
-    .iter()
-    .copied()
-    .chain([seq.to_str().unwrap()])
-    .collect::<Vec<_>>());
+        "seq",
+    ]);
     let alone = dir.join("alone.png");
     run(&[
         "--time",
@@ -311,9 +291,9 @@ fn the_sequence_command_writes_frames_timings_and_a_gif() {
         "--frames",
         "1",
         "--png",
-        alone.to_str().unwrap(),
+        "alone.png",
         "--out",
-        dir.join("alone.exr").to_str().unwrap(),
+        "alone.exr",
     ]);
     for k in 0..3 {
         assert!(seq.join(format!("frame_{k:04}.exr")).is_file());
@@ -346,5 +326,4 @@ fn the_sequence_command_writes_frames_timings_and_a_gif() {
     let frames = gif.into_frames().collect_frames().unwrap();
     assert_eq!(frames.len(), 3);
     assert_eq!(frames[0].delay().numer_denom_ms(), (500, 1));
-    let _ = std::fs::remove_dir_all(&dir);
 }

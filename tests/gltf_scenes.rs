@@ -2,11 +2,11 @@
 //! defaults for missing camera and light.
 mod common;
 
+use common::gltf::*;
 use common::*;
 use glam::{Mat4, Vec3};
 use isr::scene::{cornell::cornell_box, gltf_load, Scene};
-use isr::settings::{Method, RenderSettings};
-use serde_json::{json, Value};
+use serde_json::json;
 
 fn world_triangles(s: &Scene) -> Vec<[Vec3; 3]> {
     let mut out = Vec::new();
@@ -92,18 +92,6 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
     );
 }
 
-fn load_json(doc: &Value, name: &str) -> (Scene, std::path::PathBuf) {
-    let dir = std::env::temp_dir().join(format!("isr-gltf-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("scene.gltf");
-    std::fs::write(&p, serde_json::to_string(doc).unwrap()).unwrap();
-    (gltf_load::load(&p).unwrap(), dir)
-}
-
-fn cornell_json() -> Value {
-    serde_json::from_str(&isr::scene::export::to_gltf_json(&cornell_box()).unwrap()).unwrap()
-}
-
 #[test]
 fn node_hierarchy_transforms_compose() {
     let mut doc = cornell_json();
@@ -116,7 +104,7 @@ fn node_hierarchy_transforms_compose() {
     let scene_nodes = doc["scenes"][0]["nodes"].as_array_mut().unwrap();
     scene_nodes.retain(|n| n != 0);
     scene_nodes.push(json!(parent));
-    let (scene, _) = load_json(&doc, "hierarchy");
+    let scene = load_in("gltf-hierarchy", &doc).unwrap();
     let floor = scene
         .instances
         .iter()
@@ -136,7 +124,7 @@ fn missing_camera_and_light_get_defaults_with_warnings() {
     nodes.retain(|n| n.get("camera").is_none() && n.get("extensions").is_none());
     let n = nodes.len();
     doc["scenes"][0]["nodes"] = json!((0..n).collect::<Vec<_>>());
-    let (scene, _) = load_json(&doc, "defaults");
+    let scene = load_in("gltf-defaults", &doc).unwrap();
     assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
     assert!(scene
         .warnings
@@ -154,73 +142,24 @@ fn missing_camera_and_light_get_defaults_with_warnings() {
 #[test]
 fn base_color_texture_multiplies_the_albedo() {
     let gpu = gpu();
-    let mut doc = cornell_json();
+    let dir = temp_dir("gltf-tex");
     // An 8x1 PNG: left half pure red, right half pure blue (sRGB 255 = linear 1),
     // wide enough that bilinear filtering at u = 0.2 and 0.8 sees one color.
-    let dir = std::env::temp_dir().join(format!("isr-gltf-tex-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let texels: Vec<u8> = (0..8)
         .flat_map(|x| if x < 4 { [255, 0, 0] } else { [0, 0, 255] })
         .collect();
-    image::save_buffer(
-        dir.join("tex.png"),
-        &texels,
-        8,
-        1,
-        image::ExtendedColorType::Rgb8,
-    )
-    .unwrap();
-    doc["images"] = json!([{"uri": "tex.png"}]);
-    doc["textures"] = json!([{"source": 0}]);
-    doc["samplers"] = json!([]);
+    std::fs::write(dir.join("tex.png"), png(8, 1, &texels)).unwrap();
+    let mut d = Doc::cornell();
     // Material 0 (white, 0.75) on the floor, back wall, ceiling and blocks.
-    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    with_texture(&mut d.json, json!({"uri": "tex.png"}));
+    d.json["samplers"] = json!([]);
     // Texture coordinates for the back wall (mesh 2): u from 0 to 1 across it.
-    let uv: Vec<u8> = [[0f32, 1.], [1., 1.], [1., 0.], [0., 0.]]
-        .iter()
-        .flatten()
-        .flat_map(|f| f.to_le_bytes())
-        .collect();
-    let views = doc["bufferViews"].as_array().unwrap().len();
-    let mut bin = {
-        use base64::Engine as _;
-        let uri = doc["buffers"][0]["uri"].as_str().unwrap();
-        base64::engine::general_purpose::STANDARD
-            .decode(uri.split_once(',').unwrap().1)
-            .unwrap()
-    };
-    let offset = bin.len();
-    bin.extend(&uv);
-    {
-        use base64::Engine as _;
-        doc["buffers"][0]["uri"] = json!(format!(
-            "data:application/octet-stream;base64,{}",
-            base64::engine::general_purpose::STANDARD.encode(&bin)
-        ));
-    }
-    doc["buffers"][0]["byteLength"] = json!(bin.len());
-    doc["bufferViews"]
-        .as_array_mut()
-        .unwrap()
-        .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 32}));
-    doc["accessors"]
-        .as_array_mut()
-        .unwrap()
-        .push(json!({"bufferView": views, "componentType": 5126, "count": 4, "type": "VEC2"}));
-    let uv_accessor = doc["accessors"].as_array().unwrap().len() - 1;
-    doc["meshes"][2]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_accessor);
-    std::fs::write(dir.join("scene.gltf"), serde_json::to_string(&doc).unwrap()).unwrap();
-    let scene = gltf_load::load(&dir.join("scene.gltf")).unwrap();
+    let uv = d.floats(&[0., 1., 1., 1., 1., 0., 0., 0.], "VEC2");
+    d.json["meshes"][2]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    let scene = load(&dir, &d.embedded()).unwrap();
     assert_eq!(scene.textures.len(), 1);
 
-    let settings = RenderSettings {
-        width: 128,
-        height: 128,
-        rsm_resolution: 64,
-        method: Method::new("none"),
-        ..Default::default()
-    };
-    let out = render(&gpu, &scene, &settings, 1);
+    let out = render(&gpu, &scene, &sized("none", 128, 128, 64), 1);
     let rb = &out.readback;
     let albedo_at = |p: Vec3| {
         let (x, y) = project(&out.uniforms, rb.width, rb.height, p).unwrap();

@@ -2,81 +2,97 @@
 //! sections 2 and 4).
 mod common;
 
+use common::cli::Isr;
 use common::*;
 use glam::Vec3;
 use isr::gpu_types::{HISR_INVALID_TAU_SCALE, PATCH_INVALID};
 use isr::methods::{hisr, isr::BASE, vpls::VPLS};
 use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
-use isr::scene::{cornell::cornell_box, Camera};
+use isr::scene::{cornell::cornell_box, Camera, LightKind};
 use isr::settings::{Method, RenderSettings};
 
 fn settings(method: Method, rsm: u32) -> RenderSettings {
     RenderSettings {
-        width: 64,
-        height: 64,
-        rsm_resolution: rsm,
         method,
-        ..Default::default()
+        ..sized("none", 64, 64, rsm)
     }
 }
 
-/// Relative RMSE of the indirect image over pixels with geometry.
-fn relative_rmse(a: &RenderedMultires, reference: &RenderedMultires) -> f64 {
-    let (mut err, mut norm) = (0.0, 0.0);
-    for (i, p) in reference.readback.position.iter().enumerate() {
-        if p[3] <= 0.0 {
-            continue;
-        }
-        let (x, r) = (
-            dvec(&a.readback.indirect[i]),
-            dvec(&reference.readback.indirect[i]),
-        );
-        err += (x - r).length_squared();
-        norm += r.length_squared();
-    }
-    (err / norm).sqrt()
-}
-
-#[test]
-fn hisr_converges_to_the_dense_gather_as_tau_falls() {
+/// HISR against the dense gather of every RSM texel (the converged limit of
+/// the light-space choice), as tau falls, for each kind of light: the error
+/// falls at every step, more light patches are evaluated per eye-space patch
+/// at every step, the coarsest tau is visibly approximate and the finest
+/// matches. The spot lights the built-in box; the point and directional
+/// lights the still box, with RSMs (six faces for the point light) of 32.
+fn hisr_converges(kind: LightKind) {
     let gpu = gpu();
-    let scene = cornell_box();
-    let rsm = 64;
-    // Every RSM texel a VPL: the converged limit of the light-space choice.
+    let (scene, rsm, size, taus): (_, u32, u32, &[f32]) = match kind {
+        LightKind::Spot => (
+            cornell_box(),
+            64,
+            64,
+            &[0.5, 0.1, 0.02, 0.004, 0.0008, 0.00001],
+        ),
+        LightKind::Point => (
+            cornell_with(vec![box_point()]),
+            32,
+            48,
+            &[0.5, 0.05, 0.002, 0.00001],
+        ),
+        LightKind::Directional => (
+            cornell_with(vec![box_sun()]),
+            32,
+            48,
+            &[0.5, 0.05, 0.002, 0.00001],
+        ),
+    };
+    let at = |method| RenderSettings {
+        method,
+        ..sized("none", size, size, rsm)
+    };
     let dense = render_multires(
         &gpu,
         &scene,
-        &settings(Method::new("multires-gather"), rsm).with(&VPLS, rsm * rsm),
+        &at(Method::new("multires-gather")).with(&VPLS, rsm * rsm),
     );
     let mut errors = Vec::new();
     let mut evaluations = Vec::new();
-    for tau in [0.5, 0.1, 0.02, 0.004, 0.0008, 0.00001] {
-        let s = settings(hisr::KEY, rsm)
+    for &tau in taus {
+        let s = at(hisr::KEY)
             .with(&hisr::TAU, tau)
-            .with(&hisr::MAX_DEPTH, 6); // log2(64): down to single texels
+            // log2 of the RSM: down to single texels.
+            .with(&hisr::MAX_DEPTH, rsm.ilog2());
         let out = render_multires(&gpu, &scene, &s);
-        errors.push(relative_rmse(&out, &dense));
+        errors.push(indirect_rmse(&out.readback, &dense.readback));
         evaluations.push(isr::debug_view::light_patch_stats(&out.multires, None).per_patch_mean);
     }
-    println!("tau sweep: relative RMSE {errors:?}, light patches per eye patch {evaluations:?}");
+    println!("{kind:?}: tau {taus:?}: relative RMSE {errors:?}, light patches per eye patch {evaluations:?}");
     for w in errors.windows(2) {
-        assert!(w[1] <= w[0], "the error must fall as tau falls: {errors:?}");
+        assert!(
+            w[1] <= w[0],
+            "{kind:?}: the error must fall as tau falls: {errors:?}"
+        );
     }
     for w in evaluations.windows(2) {
         assert!(
             w[1] >= w[0],
-            "smaller tau must evaluate more patches: {evaluations:?}"
+            "{kind:?}: smaller tau must evaluate more patches: {evaluations:?}"
         );
     }
     assert!(
         errors[0] > 0.01,
-        "the coarsest setting should be visibly approximate: {errors:?}"
+        "{kind:?}: the coarsest setting should be visibly approximate: {errors:?}"
     );
     assert!(
         *errors.last().unwrap() < 1e-4,
-        "the finest setting should match the dense gather: {errors:?}"
+        "{kind:?}: the finest setting should match the dense gather: {errors:?}"
     );
 }
+
+light_kind_tests!(hisr_converges:
+    hisr_converges_to_the_dense_gather_for_a_spot_light,
+    hisr_converges_to_the_dense_gather_for_a_point_light,
+    hisr_converges_to_the_dense_gather_for_a_directional_light);
 
 #[test]
 fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
@@ -227,28 +243,19 @@ fn no_nan_or_inf_in_degenerate_configurations() {
 
 #[test]
 fn stats_and_vpl_count_view_from_the_cli() {
-    let dir = std::env::temp_dir().join(format!("isr-hisr-cli-{}", std::process::id()));
-    let out = bin()
+    let dir = temp_dir("hisr-cli");
+    let ran = Isr::render(&dir)
         .args([
-            "render", "--method", "hisr", "--width", "64", "--height", "64", "--rsm", "64",
-            "--frames", "1",
+            "--method", "hisr", "--width", "64", "--height", "64", "--rsm", "64",
         ])
-        .args(["--stats", "--debug-view", "vpl-count"])
-        .arg("--png")
-        .arg(dir.join("h.png"))
-        .arg("--out")
-        .arg(dir.join("h.exr"))
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
+        .args(["--frames", "1", "--stats", "--debug-view", "vpl-count"])
+        .args(["--png", "h.png", "--out", "h.exr"])
+        .succeeds();
     assert!(
-        out.status.success(),
+        ran.stdout
+            .contains("light patches per eye-space patch: min"),
         "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        stdout.contains("light patches per eye-space patch: min"),
-        "{stdout}"
+        ran.stdout
     );
     let heat = image::open(dir.join("h-vpl-count.png")).unwrap().to_rgb8();
     let distinct: std::collections::HashSet<_> = heat.pixels().map(|p| p.0).collect();
@@ -256,7 +263,6 @@ fn stats_and_vpl_count_view_from_the_cli() {
         distinct.len() > 3,
         "the heat map should vary over the image"
     );
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// HISR traverses the quadtree packed into one buffer: node (x, y) of depth d
@@ -334,29 +340,8 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
 /// to the 4096 leaves, more than a tile's entries).
 #[test]
 fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
-    use isr::scene::{Light, LightKind};
     let gpu = gpu();
-    let light = |kind, position, direction: Vec3, intensity| Light {
-        kind,
-        position,
-        direction: direction.normalize(),
-        color: Vec3::ONE,
-        intensity,
-        inner_cone: 0.0,
-        outer_cone: std::f32::consts::FRAC_PI_2,
-        range: None,
-    };
-    let mut two_lights = cornell_box();
-    two_lights.animation = None;
-    two_lights.lights = vec![
-        light(LightKind::Point, Vec3::new(0.3, 1.3, 0.2), -Vec3::Y, 2.0),
-        light(
-            LightKind::Directional,
-            Vec3::ZERO,
-            Vec3::new(0.4, -1.0, -0.3),
-            1.5,
-        ),
-    ];
+    let two_lights = cornell_with(vec![box_point(), box_sun()]);
     let cases = [
         ("spot", cornell_box(), 0.05, 4),
         ("spot, coarse patches", cornell_box(), 0.05, 1),
@@ -431,24 +416,4 @@ fn hisr_with_tiles_is_deterministic() {
     let b = render_multires(&gpu, &cornell_box(), &s);
     assert!(hisr::TILE_LEVEL.get(&s) > 0);
     assert_eq!(a.readback.indirect, b.readback.indirect);
-}
-
-#[test]
-fn a_tile_level_out_of_range_is_a_clean_error() {
-    let args = [
-        "render",
-        "--method",
-        "hisr",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--rsm",
-        "32",
-        "--hisr-tile-level",
-        "9",
-    ];
-    let out = bin().args(args).output().unwrap();
-    let err = clean_failure(&out, &args);
-    assert!(err.contains("--hisr-tile-level 9"), "{err}");
 }

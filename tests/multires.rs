@@ -7,18 +7,11 @@ use glam::Vec3;
 use isr::methods::vpls::{VplSampling, VPLS, VPL_SAMPLING};
 use isr::multires::{Upsample, DEPTH_THRESHOLD, NORMAL_THRESHOLD, STENCIL, UPSAMPLE};
 use isr::scene::{cornell::cornell_box, Camera, Scene};
-use isr::settings::{Method, RenderSettings};
+use isr::settings::RenderSettings;
 
 /// `multires-gather` with 256 VPLs at `width` x `height`, RSM 256.
 fn settings(width: u32, height: u32) -> RenderSettings {
-    RenderSettings {
-        width,
-        height,
-        rsm_resolution: 256,
-        method: Method::new("multires-gather"),
-        ..Default::default()
-    }
-    .with(&VPLS, 256)
+    sized("multires-gather", width, height, 256).with(&VPLS, 256)
 }
 
 /// Thresholds of 0: no texel above level 0 is smooth (the tests are strict `<`).

@@ -3,22 +3,14 @@
 //! when the device is destroyed) would say so if it did.
 mod common;
 
+use common::validating_gpu;
+
 use ash::vk;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};
 use isr::vk::pipeline::fail_pipeline_creation_after;
-use isr::vk::{Gpu, GpuOptions, Validation};
-
-fn validating_gpu() -> Gpu {
-    Gpu::new(&GpuOptions {
-        validation: Validation::Required,
-        device_index: None,
-    })
-    .unwrap_or_else(|e| {
-        panic!("{e:#}\nThis test needs the Khronos validation layer: run `bash .ci/install-vulkan --validation`.")
-    })
-}
+use isr::vk::Gpu;
 
 /// Drops `gpu` (it must be the device's last holder, so the device really is
 /// destroyed) and returns what the layer reported meanwhile.

@@ -28,25 +28,10 @@ fn direct_layer_matches_the_rasterised_direct_layer() {
 
 #[test]
 fn direct_layers_match_for_a_point_and_a_directional_light_together() {
-    let mut scene = cornell_box();
-    scene.animation = None;
-    let base = scene.lights[0];
-    scene.lights = vec![
-        isr::scene::Light {
-            kind: isr::scene::LightKind::Point,
-            position: Vec3::new(0.3, 1.3, 0.2),
-            intensity: 2.0,
-            ..base
-        },
-        isr::scene::Light {
-            kind: isr::scene::LightKind::Directional,
-            // Through the ceiling, which faces away from it: neither renderer
-            // lets a face turned away from a light cast a shadow.
-            direction: Vec3::new(0.4, -1.0, -0.3).normalize(),
-            intensity: 1.5,
-            ..base
-        },
-    ];
+    // The directional light comes through the ceiling, which faces away
+    // from it: neither renderer lets a face turned away from a light cast a
+    // shadow.
+    let scene = cornell_with(vec![box_point(), box_sun()]);
     compare_direct_layers(&scene);
 }
 
@@ -55,19 +40,7 @@ fn compare_direct_layers(scene: &Scene) {
     let gpu = gpu();
     let scene = scene.clone();
     let (w, h) = (128, 128);
-    let raster = render(
-        &gpu,
-        &scene,
-        &RenderSettings {
-            width: w,
-            height: h,
-            rsm_resolution: 1024,
-            method: Method::new("none"),
-            ..Default::default()
-        },
-        1,
-    )
-    .readback;
+    let raster = render(&gpu, &scene, &sized("none", w, h, 1024), 1).readback;
     let traced = pt(&scene, w, h, 1, 1);
     let (mut compared, mut close, mut sum_rel) = (0, 0, 0.0);
     for i in 0..(w * h) as usize {
@@ -195,19 +168,7 @@ fn path_tracer_differs_from_the_vpl_reference_where_the_bounce_is_occluded() {
     let scene = occluder_scene();
     let (w, h) = (64, 64);
     let traced = pt(&scene, w, h, 256, 7);
-    let reference = render(
-        &gpu,
-        &scene,
-        &RenderSettings {
-            width: w,
-            height: h,
-            rsm_resolution: 64,
-            method: Method::new("reference"),
-            ..Default::default()
-        },
-        1,
-    )
-    .readback;
+    let reference = render(&gpu, &scene, &sized("reference", w, h, 64), 1).readback;
     // Classify floor pixels by whether the slab blocks their view of the lit
     // wall: segments to a grid of points on the lit part of the wall.
     let (slab_vertices, slab_indices) = cuboid(SLAB_CENTER, SLAB_SIZE, 0.0);
@@ -291,29 +252,8 @@ fn path_tracer_differs_from_the_vpl_reference_where_the_bounce_is_occluded() {
 fn single_sided_occluders_shadow_alike_in_both_renderers() {
     let gpu = gpu();
     for (facing_light, shadowed) in [(true, true), (false, false)] {
-        let light = spot(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, 10.0, 40.0, 50.0);
-        let camera = Camera::look_at(
-            Vec3::new(0.0, 0.5, 4.0),
-            Vec3::ZERO,
-            Vec3::Y,
-            50f32.to_radians(),
-            0.1,
-        );
-        let mut scene = floor_scene(light, camera, 3.0, 0.5);
-        let m = scene.add_material("occluder", Vec3::splat(0.5));
-        let v = Vec3::new;
-        let up = [
-            v(-0.2, 1., 0.2),
-            v(0.2, 1., 0.2),
-            v(0.2, 1., -0.2),
-            v(-0.2, 1., -0.2),
-        ];
-        let corners = if facing_light {
-            up
-        } else {
-            [up[3], up[2], up[1], up[0]]
-        };
-        scene.add_quad("occluder", corners, m);
+        let scene = spot_over_an_occluder(facing_light);
+        let light = scene.lights[0];
         let raster = render(
             &gpu,
             &scene,

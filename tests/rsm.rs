@@ -1,18 +1,24 @@
-//! The reflective shadow map's radiometry and its quadtree (docs/algorithm.md section 2).
+//! The reflective shadow map's radiometry for each kind of light and its
+//! quadtree (docs/algorithm.md sections 2 and 2.4): a spot's RSM reflects
+//! `rho` times its intensity integrated over the cone, a point light's
+//! `rho 4 pi I` in a closed box, a directional light's `rho E` times the lit
+//! area; texel solid angles and areas sum to the frustum's and the
+//! surface's.
 mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::scene::Camera;
-use isr::settings::{Method, RenderSettings};
+use isr::renderer::Renderer;
+use isr::scene::{Camera, Light, Scene};
 use std::f64::consts::PI;
 
-/// rho * integral of I(w) over the cone, by Simpson's rule in the polar angle.
-fn expected_flux(light: &isr::scene::SpotLight, rho: f64) -> f64 {
+/// rho * integral of I(w) over the cone (KHR_lights_punctual's falloff), by
+/// Simpson's rule in the polar angle.
+fn expected_flux(light: &Light, rho: f64) -> f64 {
     let n = 20_000;
     let b = light.outer_cone as f64;
     let h = b / n as f64;
-    let f = |t: f64| light.intensity as f64 * light.angular_attenuation(t.cos()) * t.sin();
+    let f = |t: f64| light.intensity as f64 * khr_cone_attenuation(light, t.cos()) * t.sin();
     let mut sum = f(0.0) + f(b);
     for k in 1..n {
         sum += f(k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
@@ -36,13 +42,7 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
     let rho = 0.7;
     // The floor reaches past the RSM frustum on every side: every texel sees it.
     let scene = floor_scene(light, camera, 3.0, rho);
-    let settings = RenderSettings {
-        width: 64,
-        height: 64,
-        rsm_resolution: 256,
-        method: Method::new("none"),
-        ..Default::default()
-    };
+    let settings = sized("none", 64, 64, 256);
     let rsm = render(&gpu, &scene, &settings, 1).readback.rsm;
     // Every texel saw the floor (its solid angle is written wherever geometry
     // was rasterized); exactly the texels the cone lights are non-empty patches.
@@ -83,6 +83,121 @@ fn rsm_flux_sums_to_albedo_times_intensity_over_the_cone() {
         (area - area_expected).abs() < 0.01 * area_expected,
         "sum of A_j {area} vs {area_expected}"
     );
+}
+
+/// A closed box of half-size `half` around the origin, every wall facing in.
+fn inward_box(light: Light, albedo: f32) -> Scene {
+    let mut s = Scene::empty("box", light, looking_down());
+    let m = s.add_material("wall", Vec3::splat(albedo));
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = {
+                let mut n = Vec3::ZERO;
+                n[axis] = -sign;
+                n
+            };
+            let (u, v) = {
+                let mut u = Vec3::ZERO;
+                u[(axis + 1) % 3] = 1.0;
+                let mut v = Vec3::ZERO;
+                v[(axis + 2) % 3] = 1.0;
+                (u, v)
+            };
+            let c = -n;
+            let mut corners = [c - u - v, c + u - v, c + u + v, c - u + v];
+            if (corners[1] - corners[0])
+                .cross(corners[2] - corners[0])
+                .dot(n)
+                < 0.0
+            {
+                corners.reverse();
+            }
+            s.add_quad("wall", corners, m);
+        }
+    }
+    s
+}
+
+#[test]
+fn point_light_in_a_closed_box_reflects_rho_4_pi_i() {
+    let gpu = gpu();
+    let (albedo, intensity) = (0.4, 3.0);
+    let scene = inward_box(point(Vec3::new(0.2, 0.3, -0.1), intensity), albedo);
+    let settings = sized("multires-gather", 32, 32, 256);
+    let mut r = Renderer::new(&gpu, &scene, &settings).unwrap();
+    assert_eq!(r.light_views().len(), 6, "a point light is six cube faces");
+    let (mut flux, mut solid_angle) = (0.0f64, 0.0f64);
+    for f in 0..6 {
+        r.set_only_view(Some(f)).unwrap();
+        r.render_frames(1, |_| {}).unwrap();
+        let rsm = r.readback().unwrap().rsm;
+        let face_flux: f64 = rsm.flux.iter().map(|t| t[0] as f64).sum();
+        let face_dw: f64 = rsm.flux.iter().map(|t| t[3] as f64).sum();
+        // Every texel sees a wall, so every texel carries flux.
+        assert!(
+            rsm.position.iter().all(|p| p[3] > 0.0),
+            "face {f} has empty texels"
+        );
+        flux += face_flux;
+        solid_angle += face_dw;
+    }
+    drop(r);
+    assert_validation_clean(&gpu);
+    let four_pi = 4.0 * std::f64::consts::PI;
+    let expected = albedo as f64 * four_pi * intensity as f64;
+    println!("flux {flux} vs {expected}; solid angle {solid_angle} vs {four_pi}");
+    assert!(
+        ((flux - expected) / expected).abs() < 0.01,
+        "flux {flux} vs rho 4 pi I = {expected}"
+    );
+    assert!(
+        ((solid_angle - four_pi) / four_pi).abs() < 1e-3,
+        "the texels' solid angles sum to {solid_angle}, not 4 pi"
+    );
+}
+
+#[test]
+fn directional_light_reflects_rho_e_times_the_lit_area() {
+    let gpu = gpu();
+    let (albedo, e) = (0.7, 2.0);
+    // Straight down, the floor (2 x 2 m) covers the RSM up to its one-texel
+    // rim; slanted by theta, the RSM sees the floor's area times cos theta.
+    for (direction, cos_theta) in [(-Vec3::Y, 1.0), (Vec3::new(0.0, -1.0, 1.0), 0.5f64.sqrt())] {
+        let mut scene = floor_scene(sun(direction, e), looking_down(), 1.0, albedo);
+        scene.lights[0].direction = direction.normalize();
+        let settings = sized("multires-gather", 32, 32, 256);
+        let mut r = Renderer::new(&gpu, &scene, &settings).unwrap();
+        let view = r.light_views()[0];
+        r.render_frames(1, |_| {}).unwrap();
+        let rsm = r.readback().unwrap().rsm;
+        drop(r);
+        let texel = 2.0 * view.half_extent as f64 / 256.0;
+        let lit = rsm.position.iter().filter(|p| p[3] > 0.0).count() as f64;
+        let flux: f64 = rsm.flux.iter().map(|t| t[0] as f64).sum();
+        let a_rsm = lit * texel * texel;
+        let expected = albedo as f64 * e as f64 * 4.0 * cos_theta;
+        println!(
+            "{direction}: flux {flux}, rho E A_rsm {}, rho E A cos {expected}",
+            albedo as f64 * e as f64 * a_rsm
+        );
+        assert!(
+            ((flux - albedo as f64 * e as f64 * a_rsm) / flux).abs() < 1e-4,
+            "flux {flux} vs rho E A_rsm over the {lit} lit texels"
+        );
+        assert!(
+            ((flux - expected) / expected).abs() < 0.01,
+            "flux {flux} vs rho E A cos theta = {expected}"
+        );
+        // No solid angle: parallel rays.
+        assert!(rsm.flux.iter().all(|t| t[3] == 0.0));
+        // The world areas are the texel areas over cos_j.
+        let area: f64 = rsm.position.iter().map(|p| p[3] as f64).sum();
+        assert!(
+            ((area - 4.0) / 4.0).abs() < 0.01,
+            "RSM areas sum to {area}, the floor is 4 m^2"
+        );
+    }
+    assert_validation_clean(&gpu);
 }
 
 /// One node of the RSM quadtree, reduced on the CPU in f64.
@@ -161,14 +276,7 @@ fn cpu_level(
 fn rsm_quadtree_matches_an_independent_cpu_reduction() {
     let gpu = gpu();
     let scene = isr::scene::cornell::cornell_box();
-    let settings = RenderSettings {
-        width: 64,
-        height: 64,
-        rsm_resolution: 64,
-        method: Method::new("multires-gather"),
-        ..Default::default()
-    }
-    .with(&isr::methods::vpls::VPLS, 16);
+    let settings = sized("multires-gather", 64, 64, 64).with(&isr::methods::vpls::VPLS, 16);
     let m = render_multires(&gpu, &scene, &settings).multires;
     use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
     let light = scene.lights[0].position.as_dvec3();

@@ -5,18 +5,11 @@ mod common;
 
 use common::*;
 use isr::scene::cornell::cornell_box;
-use isr::settings::{Method, RenderSettings};
 
 #[test]
 fn memory_is_flat_over_300_moving_frames() {
     let gpu = gpu();
-    let settings = RenderSettings {
-        width: 32,
-        height: 32,
-        rsm_resolution: 64,
-        method: Method::new("hisr"),
-        ..Default::default()
-    };
+    let settings = sized("hisr", 32, 32, 64);
     let samples = isr::soak::run(&gpu, &cornell_box(), &settings, 300, 50, |_| {}).unwrap();
     assert_validation_clean(&gpu);
     let first = samples[0];

@@ -1,6 +1,7 @@
 //! Per-pass timings and the validation layer over several frames.
 mod common;
 
+use common::cli::Isr;
 use common::*;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
@@ -11,13 +12,7 @@ const PASSES: [&str; 5] = ["rsm", "gbuffer", "direct", "composite", "tonemap"];
 #[test]
 fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
     let gpu = gpu();
-    let settings = RenderSettings {
-        width: 128,
-        height: 128,
-        rsm_resolution: 128,
-        method: Method::new("none"),
-        ..Default::default()
-    };
+    let settings = sized("none", 128, 128, 128);
     let out = render(&gpu, &cornell_box(), &settings, 4);
     assert_eq!(out.stats.frames.len(), 4);
     // The last frame counts; the three before it only time.
@@ -64,13 +59,7 @@ fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
 #[test]
 fn patches_are_counted_only_in_a_counting_frame_and_match_the_gathered_texels() {
     let gpu = gpu();
-    let settings = RenderSettings {
-        width: 128,
-        height: 128,
-        rsm_resolution: 128,
-        method: Method::new("multires-gather"),
-        ..Default::default()
-    };
+    let settings = sized("multires-gather", 128, 128, 128);
     let mut r = Renderer::new(&gpu, &cornell_box(), &settings).expect("renderer setup");
     // Frames that only time skip the stencil pass's atomics: no counts.
     let timed = r.render_frames_counting(3, false, |_| {}).unwrap();
@@ -97,25 +86,14 @@ fn patches_are_counted_only_in_a_counting_frame_and_match_the_gathered_texels() 
 
 #[test]
 fn timings_json_from_the_cli_lists_every_pass() {
-    let dir = std::env::temp_dir().join(format!("isr-timings-{}", std::process::id()));
-    let json = dir.join("t.json");
-    let out = bin()
+    let dir = temp_dir("timings");
+    let ran = Isr::render(&dir)
         .args([
-            "render", "--width", "96", "--height", "64", "--rsm", "64", "--frames", "3",
+            "--width", "96", "--height", "64", "--rsm", "64", "--frames", "3",
         ])
-        .arg("--timings")
-        .arg(&json)
-        .arg("--out")
-        .arg(dir.join("r.exr"))
-        .arg("--png")
-        .arg(dir.join("r.png"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "isr render failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .args(["--timings", "t.json", "--out", "r.exr", "--png", "r.png"])
+        .succeeds();
+    let json = dir.join("t.json");
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     for key in [
         "device",
@@ -180,7 +158,7 @@ fn timings_json_from_the_cli_lists_every_pass() {
     }
     assert!(sum > 0.0);
 
-    let table = String::from_utf8_lossy(&out.stdout);
+    let table = &ran.stdout;
     for name in expected {
         assert!(
             table.contains(name),
@@ -190,17 +168,6 @@ fn timings_json_from_the_cli_lists_every_pass() {
     assert!(std::fs::metadata(dir.join("r.exr")).unwrap().len() > 0);
     let png = image::open(dir.join("r.png")).unwrap();
     assert_eq!((png.width(), png.height()), (96, 64));
-    let _ = std::fs::remove_dir_all(dir);
-}
-
-fn validating_gpu() -> isr::vk::Gpu {
-    let result = isr::vk::Gpu::new(&isr::vk::GpuOptions {
-        validation: isr::vk::Validation::Required,
-        device_index: None,
-    });
-    result.unwrap_or_else(|e| {
-        panic!("{e:#}\nThis test needs the Khronos validation layer: run `bash .ci/install-vulkan --validation`.")
-    })
 }
 
 #[test]
@@ -220,11 +187,8 @@ fn validation_with_synchronization_checks_is_silent_over_several_frames() {
         (Method::new("reference"), true),
     ] {
         let settings = RenderSettings {
-            width: 160,
-            height: 120,
-            rsm_resolution: 128,
             method,
-            ..Default::default()
+            ..sized("none", 160, 120, 128)
         }
         // Several submissions for the reference (4 chunks of 4,096 VPLs).
         .with(&isr::methods::reference::CHUNK, 160 * 120 * 4096)

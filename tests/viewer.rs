@@ -4,13 +4,13 @@
 //! screenshots of the presented image (overlay included) after each step.
 //! Without Xvfb the test fails and says how to install it.
 
-use std::io::{BufRead as _, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+mod common;
 
-fn isr() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_isr"))
-}
+use common::cli::Isr;
+use common::temp_dir;
+use std::io::{BufRead as _, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
 
 /// An Xvfb server on a display it picked itself (`-displayfd`), killed when dropped.
 struct Xvfb {
@@ -115,17 +115,10 @@ impl Shot {
     }
 }
 
-fn out_dir(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn viewer_switches_methods_moves_the_light_and_resizes_under_validation() {
     let x = Xvfb::start();
-    let dir = out_dir("viewer");
+    let dir = temp_dir("viewer");
     let shot = |name: &str| dir.join(format!("{name}.png"));
     // Seconds between steps: several frames at lavapipe's few frames per second.
     let script = format!(
@@ -150,9 +143,8 @@ fn viewer_switches_methods_moves_the_light_and_resizes_under_validation() {
     );
     let script_path = dir.join("script.txt");
     std::fs::write(&script_path, script).unwrap();
-    let out = isr()
+    let ran = Isr::new("view")
         .args([
-            "view",
             "--validate",
             "--paused",
             "--width",
@@ -164,12 +156,9 @@ fn viewer_switches_methods_moves_the_light_and_resizes_under_validation() {
         .arg(&script_path)
         .env("DISPLAY", &x.display)
         .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "isr view failed:\n{stderr}");
+        .succeeds();
     // `--validate` makes any message a failure; none may be printed either.
-    assert!(!stderr.contains("validation"), "{stderr}");
+    assert!(!ran.stderr.contains("validation"), "{}", ran.stderr);
 
     // The overlay's text covers the top-left; the scene is checked below it.
     let top = 200;
@@ -216,46 +205,28 @@ fn viewer_switches_methods_moves_the_light_and_resizes_under_validation() {
 
 #[test]
 fn viewer_without_a_display_says_how_to_get_one() {
-    let out = isr()
-        .args(["view"])
+    let e = Isr::new("view")
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(
-        stderr.contains("xvfb") && stderr.contains("isr render"),
-        "{stderr}"
-    );
+        .fails();
+    assert!(e.contains("xvfb") && e.contains("isr render"), "{e}");
 }
 
 #[test]
 fn viewer_script_errors_name_the_line_before_any_window_opens() {
-    let dir = out_dir("viewer-script-error");
+    let dir = temp_dir("viewer-script-error");
     let path = dir.join("bad.txt");
     std::fs::write(&path, "1 key M\n2 key Hyper\n").unwrap();
-    let out = isr()
-        .args(["view", "--script"])
+    let e = Isr::new("view")
+        .arg("--script")
         .arg(&path)
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+        .fails();
     assert!(
-        stderr.contains("line 2") && stderr.contains("unknown key `Hyper`"),
-        "{stderr}"
+        e.contains("line 2") && e.contains("unknown key `Hyper`"),
+        "{e}"
     );
-    let out = isr()
-        .args(["view", "--method", "reference"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && stderr.contains("isr render --method reference"),
-        "{stderr}"
-    );
+    let e = Isr::new("view").args(["--method", "reference"]).fails();
+    assert!(e.contains("isr render --method reference"), "{e}");
 }

@@ -1,27 +1,57 @@
-//! Helpers shared by the integration tests. Tests that need Vulkan fail with a
-//! clear message when no device is found: they never skip, so a missing install
-//! step shows up in CI.
+//! The integration tests' one kit: devices (`gpu`, `validating_gpu`),
+//! rendering and reading back (`render`, `render_multires`), the scenes and
+//! lights the tests build, the expected direct light written out from
+//! KHR_lights_punctual (not the library's own `Light` methods), CPU sums,
+//! and the bench's error measures (`isr::bench::metrics`). Submodules:
+//! `cli`, the one runner of the `isr` binary; `gltf`, the one builder of
+//! glTF and GLB files; `measure`, work counted on this thread (allocations,
+//! bytes read).
+//!
+//! Tests that need Vulkan fail with a clear message when no device is found:
+//! they never skip, so a missing install step shows up in CI.
 #![allow(dead_code)]
 
-use glam::{DVec3, Vec3, Vec4};
+pub mod cli;
+pub mod gltf;
+pub mod measure;
+
+use glam::{DVec3, Vec3};
 use isr::readback::Readback;
 use isr::renderer::{FrameStats, Renderer};
-use isr::scene::{Camera, Scene, SpotLight};
-use isr::settings::RenderSettings;
+use isr::scene::{cornell::cornell_box, Camera, Light, LightKind, Scene};
+use isr::settings::{Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions, Validation};
+
+pub use isr::bench::metrics::{geometry_mask, relative_rmse};
+
+// Devices.
 
 /// A device with the validation layer loaded when it is installed.
 pub fn gpu() -> Gpu {
-    match Gpu::new(&GpuOptions {
+    Gpu::new(&GpuOptions {
         validation: Validation::IfInstalled,
         device_index: None,
-    }) {
-        Ok(g) => g,
-        Err(e) => panic!(
+    })
+    .unwrap_or_else(|e| {
+        panic!(
             "this test needs a Vulkan device and found none usable: {e:#}\n\
              Run `bash .ci/install-vulkan` (installs Mesa's lavapipe) and try again."
-        ),
-    }
+        )
+    })
+}
+
+/// A device with the Khronos validation layer, which the test needs.
+pub fn validating_gpu() -> Gpu {
+    Gpu::new(&GpuOptions {
+        validation: Validation::Required,
+        device_index: None,
+    })
+    .unwrap_or_else(|e| {
+        panic!(
+            "{e:#}\nThis test needs the Khronos validation layer: \
+             run `bash .ci/install-vulkan --validation`."
+        )
+    })
 }
 
 /// Fails the test if the validation layer reported anything.
@@ -33,6 +63,37 @@ pub fn assert_validation_clean(gpu: &Gpu) {
         messages.len(),
         messages.join("\n")
     );
+}
+
+// Rendering.
+
+/// `method` at `width` x `height` with an RSM of `rsm`, every other setting
+/// the default.
+pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderSettings {
+    RenderSettings {
+        width,
+        height,
+        rsm_resolution: rsm,
+        method: Method::new(method),
+        ..Default::default()
+    }
+}
+
+/// `s` with the parameters that set the cost of its method made small, only
+/// where the method reads them: `vpls` VPLs, an ISR base of `isr_base`, and
+/// reference chunks of `chunk` pixel-VPLs per submission.
+pub fn small_params(mut s: RenderSettings, vpls: u32, isr_base: u32, chunk: u64) -> RenderSettings {
+    use isr::methods::{isr::BASE, reference::CHUNK, vpls::VPLS};
+    let method = isr::methods::find(s.method).expect("a registered method");
+    for p in isr::methods::params_of(method) {
+        match p.name() {
+            n if n == VPLS.name => VPLS.set(&mut s, vpls),
+            n if n == BASE.name => BASE.set(&mut s, isr_base),
+            n if n == CHUNK.name => CHUNK.set(&mut s, chunk),
+            _ => {}
+        }
+    }
+    s
 }
 
 pub struct Rendered {
@@ -57,95 +118,6 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) 
     }
 }
 
-/// The pixel (x, y) where world point `p` lands, if it is on screen.
-pub fn project(
-    u: &isr::gpu_types::FrameUniforms,
-    width: u32,
-    height: u32,
-    p: Vec3,
-) -> Option<(u32, u32)> {
-    let m = glam::Mat4::from_cols_array_2d(&u.camera_view_proj);
-    let c = m * p.extend(1.0);
-    if c.w <= 0.0 {
-        return None;
-    }
-    let ndc = c.truncate() / c.w;
-    let x = ((ndc.x * 0.5 + 0.5) * width as f32).floor();
-    let y = ((ndc.y * 0.5 + 0.5) * height as f32).floor();
-    (x >= 0.0 && y >= 0.0 && x < width as f32 && y < height as f32).then_some((x as u32, y as u32))
-}
-
-/// A spot light at `position` aimed at `target`.
-pub fn spot(
-    position: Vec3,
-    target: Vec3,
-    intensity: f32,
-    inner_deg: f32,
-    outer_deg: f32,
-) -> SpotLight {
-    SpotLight {
-        kind: isr::scene::LightKind::Spot,
-        position,
-        direction: (target - position).normalize(),
-        color: Vec3::ONE,
-        intensity,
-        inner_cone: inner_deg.to_radians(),
-        outer_cone: outer_deg.to_radians(),
-        range: None,
-    }
-}
-
-/// A scene with one horizontal square floor of half-size `half` at y = 0.
-pub fn floor_scene(light: SpotLight, camera: Camera, half: f32, albedo: f32) -> Scene {
-    let mut s = Scene::empty("floor", light, camera);
-    let m = s.add_material("floor", Vec3::splat(albedo));
-    let v = Vec3::new;
-    s.add_quad(
-        "floor",
-        [
-            v(-half, 0., half),
-            v(half, 0., half),
-            v(half, 0., -half),
-            v(-half, 0., -half),
-        ],
-        m,
-    );
-    s
-}
-
-/// The direct radiance docs/algorithm.md section 2 gives for an unshadowed
-/// Lambertian point: rho/pi * I(w) * max(0, n.l) / r^2, per channel, in f64.
-pub fn expected_direct(light: &SpotLight, albedo: Vec4, p: DVec3, n: DVec3) -> DVec3 {
-    let to_light = light.position.as_dvec3() - p;
-    let r2 = to_light.length_squared();
-    let cos = n.dot(to_light / r2.sqrt()).max(0.0);
-    albedo.truncate().as_dvec3() / std::f64::consts::PI * light.intensity_toward(p) * cos / r2
-}
-
-/// Expects `out` (a run of the `isr` binary for `args`) to have failed with
-/// an `error:` message and no panic; returns its stderr.
-pub fn clean_failure(out: &std::process::Output, args: &[&str]) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(
-        !out.status.success(),
-        "expected failure for {args:?}; stderr:\n{stderr}"
-    );
-    assert!(
-        !stderr.contains("panicked") && !stderr.contains("RUST_BACKTRACE"),
-        "panic for {args:?}:\n{stderr}"
-    );
-    assert!(
-        stderr.contains("error:"),
-        "no error message for {args:?}:\n{stderr}"
-    );
-    println!("{args:?}:\n{stderr}");
-    stderr
-}
-
-pub fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_isr"))
-}
-
 pub struct RenderedMultires {
     pub readback: Readback,
     pub multires: isr::readback::MultiresReadback,
@@ -155,7 +127,8 @@ pub struct RenderedMultires {
     pub total_area: u64,
 }
 
-/// Renders with a multiresolution method and reads back its buffer too.
+/// Renders one frame with a multiresolution method and reads back its
+/// buffer too.
 pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> RenderedMultires {
     let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
     let stats = r.render_frames(1, |_| {}).expect("rendering");
@@ -179,6 +152,245 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
     }
 }
 
+/// The pixel (x, y) where world point `p` lands, if it is on screen.
+pub fn project(
+    u: &isr::gpu_types::FrameUniforms,
+    width: u32,
+    height: u32,
+    p: Vec3,
+) -> Option<(u32, u32)> {
+    let m = glam::Mat4::from_cols_array_2d(&u.camera_view_proj);
+    let c = m * p.extend(1.0);
+    if c.w <= 0.0 {
+        return None;
+    }
+    let ndc = c.truncate() / c.w;
+    let x = ((ndc.x * 0.5 + 0.5) * width as f32).floor();
+    let y = ((ndc.y * 0.5 + 0.5) * height as f32).floor();
+    (x >= 0.0 && y >= 0.0 && x < width as f32 && y < height as f32).then_some((x as u32, y as u32))
+}
+
+/// Relative RMSE of `x`'s indirect image against `reference`'s over the
+/// reference's pixels with geometry (`isr::bench::metrics`).
+pub fn indirect_rmse(x: &Readback, reference: &Readback) -> f64 {
+    relative_rmse(
+        &x.indirect,
+        &reference.indirect,
+        &geometry_mask(&reference.position),
+    )
+}
+
+/// Pixels with geometry in `r` (G-buffer position w > 0).
+pub fn geometry_pixels(r: &Readback) -> usize {
+    geometry_mask(&r.position).iter().filter(|&&g| g).count()
+}
+
+/// One `#[test]` per kind of light, each calling `$check(kind)`:
+/// `light_kind_tests!(check: spot_test, point_test, directional_test);`.
+#[allow(unused_macros)]
+macro_rules! light_kind_tests {
+    ($check:ident: $spot:ident, $point:ident, $directional:ident) => {
+        #[test]
+        fn $spot() {
+            $check(isr::scene::LightKind::Spot);
+        }
+
+        #[test]
+        fn $point() {
+            $check(isr::scene::LightKind::Point);
+        }
+
+        #[test]
+        fn $directional() {
+            $check(isr::scene::LightKind::Directional);
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use light_kind_tests;
+
+// Lights and scenes.
+
+fn light(kind: LightKind, position: Vec3, direction: Vec3, intensity: f32) -> Light {
+    Light {
+        kind,
+        position,
+        direction: direction.normalize(),
+        color: Vec3::ONE,
+        intensity,
+        inner_cone: 0.0,
+        outer_cone: std::f32::consts::FRAC_PI_2,
+        range: None,
+    }
+}
+
+/// A spot light at `position` aimed at `target`, cones in degrees.
+pub fn spot(position: Vec3, target: Vec3, intensity: f32, inner_deg: f32, outer_deg: f32) -> Light {
+    Light {
+        inner_cone: inner_deg.to_radians(),
+        outer_cone: outer_deg.to_radians(),
+        ..light(LightKind::Spot, position, target - position, intensity)
+    }
+}
+
+/// A point light of `intensity` W/sr.
+pub fn point(position: Vec3, intensity: f32) -> Light {
+    light(LightKind::Point, position, -Vec3::Y, intensity)
+}
+
+/// A directional light giving `irradiance` W/m^2 to a surface facing it.
+pub fn sun(direction: Vec3, irradiance: f32) -> Light {
+    light(LightKind::Directional, Vec3::ZERO, direction, irradiance)
+}
+
+/// The point light the several-lights tests hang in the Cornell box.
+pub fn box_point() -> Light {
+    point(Vec3::new(0.3, 1.3, 0.2), 2.0)
+}
+
+/// The directional light of the several-lights tests: through the ceiling,
+/// which faces down and so is culled from the RSM (as single-sided faces
+/// turned away from a light are).
+pub fn box_sun() -> Light {
+    sun(Vec3::new(0.4, -1.0, -0.3), 1.5)
+}
+
+/// The Cornell box, still, lit by `lights`.
+pub fn cornell_with(lights: Vec<Light>) -> Scene {
+    let mut s = cornell_box();
+    s.animation = None;
+    s.lights = lights;
+    s
+}
+
+/// A camera 6 m above the origin looking straight down.
+pub fn looking_down() -> Camera {
+    Camera::look_at(
+        Vec3::new(0.0, 6.0, 0.0),
+        Vec3::ZERO,
+        -Vec3::Z,
+        70f32.to_radians(),
+        0.1,
+    )
+}
+
+/// The corners of a horizontal square of half-size `half` centred on `c`,
+/// facing up (+y); reversed, it faces down.
+pub fn square(c: Vec3, half: f32) -> [Vec3; 4] {
+    [
+        c + Vec3::new(-half, 0.0, half),
+        c + Vec3::new(half, 0.0, half),
+        c + Vec3::new(half, 0.0, -half),
+        c + Vec3::new(-half, 0.0, -half),
+    ]
+}
+
+/// Adds an upward-facing square of grey `albedo` to `s`.
+pub fn add_square(s: &mut Scene, name: &str, c: Vec3, half: f32, albedo: f32) {
+    let m = s.add_material(name, Vec3::splat(albedo));
+    s.add_quad(name, square(c, half), m);
+}
+
+/// A scene with one horizontal square floor of half-size `half` at y = 0.
+pub fn floor_scene(light: Light, camera: Camera, half: f32, albedo: f32) -> Scene {
+    let mut s = Scene::empty("floor", light, camera);
+    add_square(&mut s, "floor", Vec3::ZERO, half, albedo);
+    s
+}
+
+/// Index of the instance whose rest transform puts the mesh's origin at `x`.
+pub fn instance_at(s: &Scene, x: f32) -> usize {
+    s.instances
+        .iter()
+        .position(|i| (i.world_from_object.w_axis.x - x).abs() < 1e-6)
+        .unwrap()
+}
+
+/// A floor (half-size 3, grey 0.5) under a spot light 2 m above it, seen
+/// from the side, with a single-sided square occluder (half-size 0.2, at
+/// 1 m) facing the light or, reversed, facing away from it. Facing the
+/// light, it shadows |x|, |z| < 0.4 on the floor.
+pub fn spot_over_an_occluder(facing_light: bool) -> Scene {
+    let light = spot(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, 10.0, 40.0, 50.0);
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 0.5, 4.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        50f32.to_radians(),
+        0.1,
+    );
+    let mut s = floor_scene(light, camera, 3.0, 0.5);
+    let m = s.add_material("occluder", Vec3::splat(0.5));
+    let mut corners = square(Vec3::new(0.0, 1.0, 0.0), 0.2);
+    if !facing_light {
+        corners.reverse();
+    }
+    s.add_quad("occluder", corners, m);
+    s
+}
+
+// The expected direct light, from KHR_lights_punctual written out here.
+
+/// The extension's smooth cone falloff for a spot light at `cos_angle` off its
+/// axis: `t = clamp(cos * scale + offset, 0, 1)`, `t^2`, with
+/// `scale = 1 / max(0.001, cos inner - cos outer)` and
+/// `offset = -cos outer * scale`; 1 for point and directional lights.
+pub fn khr_cone_attenuation(light: &Light, cos_angle: f64) -> f64 {
+    if light.kind != LightKind::Spot {
+        return 1.0;
+    }
+    let cos_outer = (light.outer_cone as f64).cos();
+    let cos_inner = (light.inner_cone as f64).cos();
+    let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+    let offset = -cos_outer * scale;
+    let t = (cos_angle * scale + offset).clamp(0.0, 1.0);
+    t * t
+}
+
+/// What a spot or point light loses toward `p` beyond `1 / d^2`: the cone's
+/// falloff (spot lights) times the range window `clamp(1 - (d / range)^4,
+/// 0, 1)` when a range is set; 1 for directional lights.
+pub fn khr_attenuation(light: &Light, p: DVec3) -> f64 {
+    if light.kind == LightKind::Directional {
+        return 1.0;
+    }
+    let from_light = p - light.position.as_dvec3();
+    let d = from_light.length();
+    let axis = light.direction.as_dvec3().normalize();
+    let mut a = khr_cone_attenuation(light, from_light.dot(axis) / d);
+    if let Some(range) = light.range {
+        a *= (1.0 - (d / range as f64).powi(4)).clamp(0.0, 1.0);
+    }
+    a
+}
+
+/// Irradiance (W/m^2 per channel) at `p` on a surface with normal `n`,
+/// unshadowed: `I khr_attenuation cos / d^2` for spot and point lights,
+/// `E cos` for directional ones.
+pub fn khr_irradiance(light: &Light, p: DVec3, n: DVec3) -> DVec3 {
+    let color = light.color.as_dvec3() * light.intensity as f64;
+    if light.kind == LightKind::Directional {
+        let to_light = -light.direction.as_dvec3().normalize();
+        return color * n.dot(to_light).max(0.0);
+    }
+    let to_light = light.position.as_dvec3() - p;
+    let d2 = to_light.length_squared();
+    let cos = n.dot(to_light / d2.sqrt()).max(0.0);
+    color * khr_attenuation(light, p) * cos / d2
+}
+
+/// Direct radiance of an unshadowed Lambertian point of grey `albedo`
+/// (docs/algorithm.md section 2): `rho / pi` times `khr_irradiance`.
+pub fn expected_direct(light: &Light, albedo: f64, p: DVec3, n: DVec3) -> DVec3 {
+    khr_irradiance(light, p, n) * albedo / std::f64::consts::PI
+}
+
+// CPU sums.
+
+pub fn dvec(a: &[f32; 4]) -> DVec3 {
+    DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
+}
+
 /// The regular VPLs of RSM quadtree level `k` as (position, normal, flux, area).
 pub fn vpls_at(m: &isr::readback::MultiresReadback, k: usize) -> Vec<(DVec3, DVec3, DVec3, f64)> {
     let [pos, nrm, flux] = &m.rsm_tree[k];
@@ -186,10 +398,7 @@ pub fn vpls_at(m: &isr::readback::MultiresReadback, k: usize) -> Vec<(DVec3, DVe
         .zip(nrm)
         .zip(flux)
         .filter(|((p, _), _)| p[3] > 0.0)
-        .map(|((p, n), f)| {
-            let v = |a: &[f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
-            (v(p), v(n), v(f), p[3] as f64)
-        })
+        .map(|((p, n), f)| (dvec(p), dvec(n), dvec(f), p[3] as f64))
         .collect()
 }
 
@@ -208,6 +417,10 @@ pub fn cpu_gather(vpls: &[(DVec3, DVec3, DVec3, f64)], x: DVec3, n: DVec3) -> DV
     e
 }
 
-pub fn dvec(a: &[f32; 4]) -> DVec3 {
-    DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
+/// A fresh empty folder under the system temp dir, for one test's files.
+pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("isr-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
 }
