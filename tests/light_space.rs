@@ -128,6 +128,16 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
         non_empty,
         "every non-empty base patch is chosen once"
     );
+    let lit = regular
+        .readback
+        .indirect
+        .iter()
+        .filter(|p| dvec(p).max_element() > 0.0)
+        .count();
+    assert!(
+        2 * lit >= geometry_pixels(&regular.readback),
+        "only {lit} pixels have indirect light"
+    );
     for (i, (a, b)) in isr_indirect
         .iter()
         .zip(&regular.readback.indirect)

@@ -209,7 +209,7 @@ fn level_zero_gather_equals_the_cpu_sum() {
     assert_eq!(m.rsm_tree[k][0].len(), 256, "256 VPLs at level {k}");
     let vpls = vpls_at(m, k);
     let mut checked = 0;
-    for i in (0..rb_len(&out)).step_by(7) {
+    for i in (0..out.readback.position.len()).step_by(7) {
         let p = out.readback.position[i];
         if p[3] <= 0.0 {
             continue;
@@ -224,10 +224,25 @@ fn level_zero_gather_equals_the_cpu_sum() {
         checked += 1;
     }
     assert!(checked > 1000);
+    assert_sampled(checked, 7, &out, 0.5);
 }
 
-fn rb_len(out: &RenderedMultires) -> usize {
-    out.readback.position.len()
+/// A comparison at every `stride`-th pixel that checked `checked` of them
+/// compared enough: at least 90% of the pixels with geometry it sampled, and
+/// geometry covers at least `coverage` of the image (an empty or black image
+/// cannot pass).
+fn assert_sampled(checked: usize, stride: usize, out: &RenderedMultires, coverage: f64) {
+    let rb = &out.readback;
+    let (geometry, all) = (geometry_pixels(rb), rb.position.len());
+    println!("compared {checked} pixels of every {stride}; {geometry} of {all} have geometry");
+    assert!(
+        geometry as f64 >= coverage * all as f64,
+        "only {geometry} of {all} pixels have geometry"
+    );
+    assert!(
+        checked as f64 >= 0.9 * geometry as f64 / stride as f64,
+        "compared {checked} pixels, of every {stride}th of {geometry} with geometry"
+    );
 }
 
 #[test]
@@ -261,6 +276,15 @@ fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
     assert!(
         checked.iter().filter(|&&c| c > 0).count() >= 3,
         "patches checked per level: {checked:?}"
+    );
+    // The patches partition the pixels with geometry
+    // (`stencilled_texels_partition_the_pixels_with_geometry`): the checked
+    // ones cover them all.
+    let covered: usize = checked.iter().enumerate().map(|(l, c)| c << (2 * l)).sum();
+    let geometry = geometry_pixels(&out.readback);
+    assert!(
+        geometry > 0 && covered >= geometry,
+        "the checked patches cover {covered} pixels, {geometry} have geometry"
     );
 }
 
@@ -363,6 +387,7 @@ fn interpolated_upsampling_leaves_no_seams_on_a_flat_wall() {
     );
     let worst = |r: &RenderedMultires| {
         let mut worst: f64 = 0.0;
+        let mut compared = 0;
         for (i, p) in reference.readback.position.iter().enumerate() {
             if p[3] <= 0.0 {
                 continue;
@@ -372,7 +397,10 @@ fn interpolated_upsampling_leaves_no_seams_on_a_flat_wall() {
                 dvec(&reference.readback.indirect[i]),
             );
             worst = worst.max(((a - b).abs() / b).max_element());
+            compared += 1;
         }
+        // The wall fills the view: every pixel is compared.
+        assert_sampled(compared, 1, r, 1.0);
         worst
     };
     let (wi, wn) = (worst(&interpolated), worst(&nearest));
@@ -414,6 +442,7 @@ fn point_sampled_vpls_scale_flux_by_the_patch_size() {
             })
         })
         .collect();
+    let mut checked = 0;
     for i in (0..out.readback.position.len()).step_by(5) {
         let p = out.readback.position[i];
         if p[3] <= 0.0 {
@@ -425,5 +454,7 @@ fn point_sampled_vpls_scale_flux_by_the_patch_size() {
             (got - expected).abs().max_element() <= 1e-4 * expected.max_element() + 1e-7,
             "pixel {i}: {got:?} vs {expected:?}"
         );
+        checked += 1;
     }
+    assert_sampled(checked, 5, &out, 0.5);
 }
