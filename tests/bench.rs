@@ -25,6 +25,84 @@ fn lines(p: &Path) -> usize {
     std::fs::read_to_string(p).unwrap().lines().count()
 }
 
+/// The errors a row reports against the reference of its frames.
+const ERRORS: [&str; 3] = ["rel_rmse_indirect", "rel_rmse_final", "flip"];
+
+/// The reference rows have no error; every other method's rows, ordered by
+/// a cost that does not depend on timing (more VPLs, a larger ISR base, a
+/// smaller tau at the same depth), have errors that fall: relative RMSE of
+/// the indirect and final images strictly at every step (the quick sweep's
+/// smallest falls, measured: 10.8% and 9.8%, HISR on slats), FLIP never
+/// rising (its smallest fall: 1.3%, restricted splats on slats).
+fn errors_fall_as_the_cost_rises(rows: &[serde_json::Value]) {
+    let param = |r: &serde_json::Value, name: &str| -> Option<f64> {
+        r["params"][name].as_str().map(|v| v.parse().unwrap())
+    };
+    let mut groups: std::collections::BTreeMap<(String, String, String), Vec<&serde_json::Value>> =
+        Default::default();
+    for r in rows {
+        let (scene, method) = (r["scene"].to_string(), r["method"].as_str().unwrap());
+        if method == "reference" {
+            for k in ERRORS {
+                assert_eq!(r[k].as_f64(), Some(0.0), "{k} of the reference in {r}");
+            }
+            continue;
+        }
+        // HISR's taus are compared at one max depth.
+        let depth = if param(r, "tau").is_some() {
+            r["params"]["max-depth"].to_string()
+        } else {
+            String::new()
+        };
+        groups
+            .entry((scene, method.to_string(), depth))
+            .or_default()
+            .push(r);
+    }
+    assert!(!groups.is_empty());
+    for ((scene, method, _), mut group) in groups {
+        // The sweep's parameter, and the cost order of its values.
+        let cost = |r: &serde_json::Value| -> f64 {
+            if let Some(v) = param(r, "vpls") {
+                v
+            } else if let Some(b) = param(r, "isr-base") {
+                b
+            } else if let Some(tau) = param(r, "tau") {
+                -tau
+            } else {
+                panic!(
+                    "no cost order known for the sweep of {method}: {}",
+                    r["params"]
+                )
+            }
+        };
+        group.sort_by(|a, b| cost(a).total_cmp(&cost(b)));
+        assert!(group.len() >= 2, "{scene} {method}: one sweep point");
+        for w in group.windows(2) {
+            let (cheap, dear) = (w[0], w[1]);
+            assert!(
+                cost(cheap) < cost(dear),
+                "{scene} {method}: two points of one cost"
+            );
+            for k in ERRORS {
+                let (a, b) = (cheap[k].as_f64().unwrap(), dear[k].as_f64().unwrap());
+                println!(
+                    "{scene} {method} {k}: {} -> {}: {a:.5} -> {b:.5} ({:+.1}%)",
+                    cheap["label"],
+                    dear["label"],
+                    100.0 * (b - a) / a
+                );
+                let falls = if k == "flip" { b <= a } else { b < a };
+                assert!(
+                    falls,
+                    "{scene} {method}: {k} {a} at {} but {b} at {}",
+                    cheap["label"], dear["label"]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     let dir = temp_dir("bench-quick");
@@ -68,6 +146,7 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
             assert!(r["flicker"].as_f64().is_some(), "flicker in {r}");
         }
     }
+    errors_fall_as_the_cost_rises(rows);
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
     for cell in csv.lines().skip(1).flat_map(|l| l.split(',')) {
