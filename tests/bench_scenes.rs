@@ -1,6 +1,9 @@
 //! The stress scenes in `assets/` load, and match the code that generates
 //! them (`examples/stress_scenes.rs`, `isr::bench::scenes`).
 
+mod common;
+
+use common::assert_light_and_camera_agree;
 use isr::bench::scenes;
 
 #[test]
@@ -25,20 +28,7 @@ fn every_stress_scene_asset_loads_and_matches_its_generator() {
         assert!((duration - built.animation_duration().unwrap()).abs() < 1e-6);
         for t in [0.0, 0.7, 1.9, duration] {
             let (a, b) = (loaded.state_at(t), built.state_at(t));
-            assert!(
-                a.lights[0].position.abs_diff_eq(b.lights[0].position, 1e-4)
-                    && a.lights[0]
-                        .direction
-                        .abs_diff_eq(b.lights[0].direction, 1e-4),
-                "{} light at {t}",
-                s.name
-            );
-            let cam = |c: &isr::scene::Camera| c.world_from_camera;
-            assert!(
-                cam(&a.camera).abs_diff_eq(cam(&b.camera), 1e-4),
-                "{} camera at {t}",
-                s.name
-            );
+            assert_light_and_camera_agree(&a, &b, 1e-4, 1e-4, &format!("{} at {t}", s.name));
             // Instances are compared as placed in the world.
             let pos = |sc: &isr::scene::Scene, st: &isr::scene::FrameState| -> Vec<glam::Vec3> {
                 let mut v: Vec<glam::Vec3> = sc

@@ -72,19 +72,7 @@ fn assets_cornell_gltf_is_the_built_in_scene() {
     );
     for t in [-1.0, 0.0, 0.4, 1.0, 1.7, 2.5, 3.0, 3.9, 4.0, 7.0] {
         let (a, b) = (file.state_at(t), builtin.state_at(t));
-        assert!(
-            a.lights[0].position.abs_diff_eq(b.lights[0].position, 1e-6)
-                && a.lights[0]
-                    .direction
-                    .abs_diff_eq(b.lights[0].direction, 1e-6),
-            "light at {t} s: {:?} vs {:?}",
-            a.lights[0],
-            b.lights[0]
-        );
-        assert!(a
-            .camera
-            .world_from_camera
-            .abs_diff_eq(b.camera.world_from_camera, 1e-5));
+        assert_light_and_camera_agree(&a, &b, 1e-6, 1e-5, &format!("at {t} s"));
     }
     assert!(
         builtin.state_at(1.0).lights[0].direction.x > 0.5,

@@ -329,6 +329,32 @@ pub fn spot_over_an_occluder(facing_light: bool) -> Scene {
     s
 }
 
+/// Asserts that light 0 and the camera of two frame states agree: light
+/// positions and directions within `light_tol`, camera matrices within
+/// `camera_tol`.
+pub fn assert_light_and_camera_agree(
+    a: &isr::scene::FrameState,
+    b: &isr::scene::FrameState,
+    light_tol: f32,
+    camera_tol: f32,
+    what: &str,
+) {
+    let (la, lb) = (&a.lights[0], &b.lights[0]);
+    assert!(
+        la.position.abs_diff_eq(lb.position, light_tol)
+            && la.direction.abs_diff_eq(lb.direction, light_tol),
+        "{what}: light {la:?} vs {lb:?}"
+    );
+    assert!(
+        a.camera
+            .world_from_camera
+            .abs_diff_eq(b.camera.world_from_camera, camera_tol),
+        "{what}: camera {:?} vs {:?}",
+        a.camera,
+        b.camera
+    );
+}
+
 // The expected direct light, from KHR_lights_punctual written out here.
 
 /// The extension's smooth cone falloff for a spot light at `cos_angle` off its
