@@ -5,7 +5,7 @@
 #include "frame.glsl"
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
-layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;    // xyz: unit normal; w: view depth (16-bit)
+layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;    // xyz: unit normal; w: view depth, scaled (16-bit)
 
 #define GEO_LEVEL0_ONLY
 #include "geo_levels.glsl"
@@ -14,7 +14,9 @@ layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;    // xyz: unit n
 // Level 1 from the G-buffer's 4x4 pixels around texel p (its 2x2 children
 // and their one-pixel ring): the children's sums and the ranges over the
 // pixels with geometry. The ranges take the view depth from the normal's w
-// (16 bits, relative error under 0.05%), so the ring costs one fetch per
+// (16 bits, relative error under 0.05%; scaled by a power of two fitted to
+// the scene so that no depth it holds overflows or underflows, which the
+// ranges' ratios do not see), so the ring costs one fetch per
 // pixel; the means take it from the position (32 bits). Each pixel is fetched
 // unconditionally (clamped, then masked): fetches under a condition cost CPU
 // drivers as much as taken ones.

@@ -12,7 +12,8 @@ struct FrameUniforms {
     vec3 camera_position;   // world (m)
     float pad0;
     vec3 camera_forward;    // unit view direction
-    float pad1;
+    float normal_depth_scale; // the G-buffer normal's w holds view depth times this (a
+                            // power of two fitted to the scene: it is 16-bit)
     vec3 light_position;    // world (m)
     float light_range;      // m, 0 = no range
     vec3 light_direction;   // unit spot axis, or the directional light's direction

@@ -14,7 +14,8 @@ pub struct FrameUniforms {
     pub camera_position: [f32; 3],
     pub pad0: f32,
     pub camera_forward: [f32; 3],
-    pub pad1: f32,
+    /// The G-buffer normal's w is view depth times this (`view::normal_depth_scale`).
+    pub normal_depth_scale: f32,
     pub light_position: [f32; 3],
     /// Metres, 0 = none.
     pub light_range: f32,

@@ -60,6 +60,20 @@ pub struct MultiresReadback {
     pub rsm_tree: Vec<[Vec<[f32; 4]>; 3]>,
 }
 
+/// Positions read back relative to the render origin (xyz; w holds
+/// something else, and 0 where there is nothing) made world positions.
+pub fn to_world(positions: &mut [[f32; 4]], origin: glam::DVec3) {
+    if origin == glam::DVec3::ZERO {
+        return;
+    }
+    for p in positions {
+        if p[3] != 0.0 {
+            let q = glam::Vec3::from_slice(&p[..3]).as_dvec3() + origin;
+            p[..3].copy_from_slice(&q.as_vec3().to_array());
+        }
+    }
+}
+
 /// One mip level of one layer of an image, to copy to the host under `name`.
 #[derive(Clone)]
 pub struct Region<'a> {

@@ -63,7 +63,7 @@ pub fn run(
     let mut samples = Vec::new();
     for k in 0..frames {
         let t = k as f32 / 30.0;
-        let mut state = scene.state_at(t);
+        let mut state = scene.pose_at(t)?;
         motion::orbit_light(&mut state, pivot, 3.0, t);
         motion::orbit_camera(&mut state, pivot, 5.0, t);
         r.update(&state)?;

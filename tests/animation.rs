@@ -70,9 +70,14 @@ fn nested_animated_nodes_compose_parent_then_child() {
         st.instance_transforms[still],
         s.instances[still].world_from_object
     );
-    // The camera 1 m along the slider's +Z (scaled by 2).
-    let mut eye = mesh;
-    eye.w_axis += Vec4::new(2.0 * sn, 0.0, 2.0 * c, 0.0);
+    // The camera 1 m along the slider's +Z (scaled by 2), turned as the
+    // slider, without its scale (a camera's view is its own).
+    let eye = Mat4::from_cols(
+        mesh.x_axis / 2.0,
+        mesh.y_axis / 2.0,
+        mesh.z_axis / 2.0,
+        mesh.w_axis + Vec4::new(2.0 * sn, 0.0, 2.0 * c, 0.0),
+    );
     assert!(st.camera.world_from_camera.abs_diff_eq(eye, 1e-6));
     // The light 1 m along the spinner's +Z, pointing along its -Z.
     assert!(st.lights[0]

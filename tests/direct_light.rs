@@ -203,7 +203,7 @@ fn occluder_shadows_the_floor(kind: LightKind) {
     let points =
         (case.shadowed.iter().map(|&p| (p, false))).chain(case.lit.iter().map(|&p| (p, true)));
     for (at, lit) in points {
-        let (x, y) = project(&rendered.uniforms, size, size, at).expect("on screen");
+        let (x, y) = project(&rendered, at).expect("on screen");
         let i = (y * size + x) as usize;
         let p = dvec(&out.position[i]);
         assert!(

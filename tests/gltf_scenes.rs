@@ -150,7 +150,7 @@ fn base_color_texture_multiplies_the_albedo() {
     let out = render(&gpu, &scene, &sized("none", 128, 128, 64), 1);
     let rb = &out.readback;
     let albedo_at = |p: Vec3| {
-        let (x, y) = project(&out.uniforms, rb.width, rb.height, p).unwrap();
+        let (x, y) = project(&out, p).unwrap();
         rb.albedo[(y * rb.width + x) as usize]
     };
     // Back wall at u = 0.2 and u = 0.8.

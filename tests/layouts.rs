@@ -99,7 +99,7 @@ fn frame_uniforms_match_shared_glsl() {
             camera_position => "camera_position",
             pad0 => "pad0",
             camera_forward => "camera_forward",
-            pad1 => "pad1",
+            normal_depth_scale => "normal_depth_scale",
             light_position => "light_position",
             light_range => "light_range",
             light_direction => "light_direction",

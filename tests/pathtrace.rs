@@ -266,7 +266,7 @@ fn single_sided_occluders_shadow_alike_in_both_renderers() {
             1,
         );
         let traced = pt(&scene, 64, 64, 1, 1);
-        let (x, y) = project(&raster.uniforms, 64, 64, Vec3::ZERO).unwrap();
+        let (x, y) = project(&raster, Vec3::ZERO).unwrap();
         let i = (y * 64 + x) as usize;
         let unshadowed = light.intensity as f64 * 0.5 / std::f64::consts::PI / 4.0;
         for (name, direct) in [

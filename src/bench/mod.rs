@@ -352,7 +352,7 @@ fn run_scene(
                 k + 1,
                 plan.frames
             ));
-            r.update(&scene.state_at(frame_time(spec, k)))?;
+            r.update(&scene.pose_at(frame_time(spec, k))?)?;
             let last = k + 1 == plan.frames;
             ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
             let out = r.readback()?;
@@ -407,7 +407,7 @@ fn run_scene(
                 k + 1,
                 plan.frames
             ));
-            r.update(&scene.state_at(frame_time(spec, k)))?;
+            r.update(&scene.pose_at(frame_time(spec, k))?)?;
             let n = if k == 0 { plan.timing_frames } else { 1 };
             // Every frame times but the run's last, which counts (`Profiler`).
             let last = k + 1 == plan.frames;

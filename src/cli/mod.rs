@@ -101,8 +101,8 @@ struct RenderArgs {
 
 impl RenderArgs {
     /// The scene's frame state at animation time `t`, with the built-in motion.
-    fn state_at(&self, scene: &scene::Scene, t: f32) -> scene::FrameState {
-        let mut state = scene.state_at(t);
+    fn state_at(&self, scene: &scene::Scene, t: f32) -> Result<scene::FrameState> {
+        let mut state = scene.pose_at(t)?;
         let pivot = scene::motion::pivot(scene);
         if let Some(period) = self.orbit_light {
             scene::motion::orbit_light(&mut state, pivot, period, t);
@@ -110,7 +110,7 @@ impl RenderArgs {
         if let Some(period) = self.orbit_camera {
             scene::motion::orbit_camera(&mut state, pivot, period, t);
         }
-        state
+        Ok(state)
     }
 
     /// The timing report of `stats` for this run.
@@ -266,7 +266,7 @@ fn render(args: RenderArgs) -> Result<()> {
             eprintln!("warning: --method pathtrace does not read --{name}; it has no effect");
         }
         // The CPU reference renders the scene posed at --time.
-        let state = args.state_at(&scene, run.time);
+        let state = args.state_at(&scene, run.time)?;
         let mut posed = scene.clone();
         posed.camera = state.camera;
         posed.lights = state.lights;
@@ -301,7 +301,7 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(dir) = &args.sequence {
         return sequence(&args, &scene, &gpu, &mut renderer, dir);
     }
-    renderer.update(&args.state_at(&scene, run.time))?;
+    renderer.update(&args.state_at(&scene, run.time)?)?;
     let frames = args.frames;
     let mut bar: Option<indicatif::ProgressBar> = None;
     let mut finished = 0;

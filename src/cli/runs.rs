@@ -102,7 +102,7 @@ pub(super) fn sequence(
     let bar = crate::progress::bar(args.frames as u64, "frames");
     for k in 0..args.frames {
         let t = args.run.time + k as f32 / args.fps;
-        renderer.update(&args.state_at(scene, t))?;
+        renderer.update(&args.state_at(scene, t)?)?;
         // Each frame is its own run of one frame: its images are read back
         // before the next one changes the scene.
         let stats = renderer.render_frames(1, |_| {}).map_err(|e| {

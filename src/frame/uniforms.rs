@@ -9,8 +9,13 @@ use crate::view::{self, LightView};
 
 /// What the shaders need of `state` for an image of `s.width` x `s.height`,
 /// seen from the light RSM `v` (one of `view::light_views` of `state`'s light
-/// `v.light`).
-pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, v: &LightView) -> FrameUniforms {
+/// `v.light`), for a scene within `bounds` (in `state`'s frame).
+pub fn frame_uniforms(
+    state: &FrameState,
+    s: &RenderSettings,
+    v: &LightView,
+    bounds: (glam::Vec3, glam::Vec3),
+) -> FrameUniforms {
     let cam = &state.camera;
     let l = &state.lights[v.light];
     let (scale, offset) = l.cone_scale_offset();
@@ -29,6 +34,7 @@ pub fn frame_uniforms(state: &FrameState, s: &RenderSettings, v: &LightView) -> 
         light_view_proj: v.view_proj.to_cols_array_2d(),
         camera_position: cam.position().to_array(),
         camera_forward: cam.forward().to_array(),
+        normal_depth_scale: view::normal_depth_scale(cam.position(), bounds),
         light_position: v.position.to_array(),
         light_range: range,
         light_direction: v.direction.to_array(),

@@ -23,13 +23,24 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Materials as the path tracer shades them: albedo factor and optional texture.
+/// Materials as the path tracer shades them: albedo factor and optional
+/// texture. Geometry and lights are held relative to `origin` (the camera),
+/// in f32 made from f64, so that a scene far from the world's origin keeps
+/// the precision it has at the origin.
 struct Shading<'a> {
     scene: &'a Scene,
     bvh: Bvh,
+    /// The lights, their positions relative to `origin`.
     lights: Vec<Light>,
-    /// Ray offset off surfaces, relative to the scene size.
-    epsilon: f32,
+    origin: glam::DVec3,
+}
+
+/// How far a ray starts off the surface at `p` (relative to the camera):
+/// many times the f32 rounding of `p`'s coordinates, whatever the scene's
+/// size or place. A fixed share of the scene's extent was 9 m once one
+/// object stood 500 km away, and every ray left the room (issue 29).
+fn ray_offset(p: Vec3A) -> f32 {
+    (p.abs().max_element() * 2e-6).max(f32::MIN_POSITIVE * 1e6)
 }
 
 /// A small, fast generator (PCG32) seeded per pixel, so results do not depend
@@ -79,17 +90,20 @@ struct SurfacePoint {
 
 impl Shading<'_> {
     fn new(scene: &Scene) -> Shading<'_> {
+        let origin = scene.camera.position().as_dvec3();
         let mut triangles = Vec::new();
         for inst in &scene.instances {
             let mesh = &scene.meshes[inst.mesh];
             let m = inst.world_from_object;
+            let relative = inst.world_from_object.as_dmat4();
             let normal_matrix = Mat4::from_mat3(glam::Mat3::from_mat4(m).inverse().transpose());
             let double_sided = scene.materials[mesh.material].double_sided;
             for t in mesh.indices.chunks_exact(3) {
                 let v = |k: usize| &mesh.vertices[t[k] as usize];
                 triangles.push(Triangle {
                     p: std::array::from_fn(|k| {
-                        Vec3A::from(m.transform_point3(Vec3::from(v(k).position)))
+                        let p = relative.transform_point3(Vec3::from(v(k).position).as_dvec3());
+                        Vec3A::from((p - origin).as_vec3())
                     }),
                     n: std::array::from_fn(|k| {
                         Vec3A::from(normal_matrix.transform_vector3(Vec3::from(v(k).normal)))
@@ -101,12 +115,19 @@ impl Shading<'_> {
                 });
             }
         }
-        let size = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| Light {
+                position: (l.position.as_dvec3() - origin).as_vec3(),
+                ..*l
+            })
+            .collect();
         Shading {
             scene,
             bvh: Bvh::new(triangles),
-            lights: scene.lights.clone(),
-            epsilon: size * 1e-5,
+            lights,
+            origin,
         }
     }
 
@@ -137,7 +158,7 @@ impl Shading<'_> {
         let hit = self.bvh.intersect(
             origin,
             dir,
-            self.epsilon,
+            ray_offset(origin),
             f32::INFINITY,
             false,
             Cull::BackFaces,
@@ -188,6 +209,7 @@ impl Shading<'_> {
         if cos <= 0.0 || r2 == 0.0 || !cos.is_finite() {
             return Vec3::ZERO;
         }
+        // Both relative to `origin`, as the lights here are.
         let at = Vec3::from(s.position).as_dvec3();
         // W/sr for spot and point lights, E (W/m^2) for directional ones (r2 = 1).
         let intensity = if light.kind == LightKind::Directional {
@@ -198,18 +220,12 @@ impl Shading<'_> {
         if intensity.max_element() <= 0.0 {
             return Vec3::ZERO;
         }
-        let origin = s.position + s.normal * self.epsilon;
+        let offset = ray_offset(s.position);
+        let origin = s.position + s.normal * offset;
         // Towards the light: blocked by faces turned to the light, as in the RSM.
         if self
             .bvh
-            .intersect(
-                origin,
-                l,
-                self.epsilon,
-                r * (1.0 - 1e-4),
-                true,
-                Cull::FrontFaces,
-            )
+            .intersect(origin, l, offset, r * (1.0 - 1e-4), true, Cull::FrontFaces)
             .is_some()
         {
             return Vec3::ZERO;
@@ -226,7 +242,7 @@ impl Shading<'_> {
         let b = n.x * n.y * a;
         let t = Vec3A::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
         let bt = Vec3A::new(b, sign + n.y * n.y * a, -n.y);
-        let origin = s.position + n * self.epsilon;
+        let origin = s.position + n * ray_offset(s.position);
         let mut sum = Vec3::ZERO;
         for _ in 0..spp {
             let (u1, u2) = (rng.uniform(), rng.uniform());
@@ -269,9 +285,15 @@ pub fn render(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Readback {
     let shading = Shading::new(scene);
-    let clip_to_world = crate::view::camera_view_proj(&scene.camera, s.width, s.height).inverse();
-    let eye = Vec3A::from(scene.camera.position());
+    // Rays in the shading's frame: the camera at its origin.
+    let at_origin = crate::scene::Camera {
+        world_from_camera: Mat4::from_quat(glam::Quat::from_mat4(&scene.camera.world_from_camera)),
+        ..scene.camera
+    };
+    let clip_to_world = crate::view::camera_view_proj(&at_origin, s.width, s.height).inverse();
+    let eye = Vec3A::ZERO;
     let forward = Vec3A::from(scene.camera.forward());
+    let world_origin = shading.origin;
     let (w, h) = (s.width as usize, s.height as usize);
     let mut pixels = vec![[[0f32; 4]; 6]; w * h]; // final, direct, indirect, albedo, normal, position
     let rows_done = AtomicUsize::new(0);
@@ -305,14 +327,15 @@ pub fn render(
                 let direct = shading.direct(&hit);
                 let indirect = shading.indirect(&hit, s.spp, &mut rng);
                 let final_radiance = direct + hit.albedo / PI * indirect;
-                let depth = (hit.position - eye).dot(forward).max(1e-6);
+                let depth = (hit.position - eye).dot(forward).max(f32::MIN_POSITIVE);
+                let position = (Vec3::from(hit.position).as_dvec3() + world_origin).as_vec3();
                 *out = [
                     final_radiance.extend(1.0).to_array(),
                     direct.extend(1.0).to_array(),
                     indirect.extend(1.0).to_array(),
                     hit.albedo.extend(1.0).to_array(),
                     Vec3::from(hit.normal).extend(0.0).to_array(),
-                    Vec3::from(hit.position).extend(depth).to_array(),
+                    position.extend(depth).to_array(),
                 ];
             }
             done.fetch_add(1, Ordering::Relaxed);

@@ -120,6 +120,14 @@ pub struct Renderer<'g> {
     /// The scene's bounds as loaded: they place the RSM near plane and fit
     /// directional lights' RSMs.
     bounds: (glam::Vec3, glam::Vec3),
+    /// Each instance's mesh bounds in object space, for fitting directional
+    /// lights' RSMs to the view (`view::fit_directional`).
+    object_bounds: Vec<(glam::Vec3, glam::Vec3)>,
+    /// What the GPU renders relative to (`scene::render_origin`): `state`,
+    /// `views` and every position on the GPU are relative to it, and
+    /// readbacks add it back.
+    origin: glam::DVec3,
+    /// The current frame state, relative to `origin`.
     state: FrameState,
     /// Every RSM a frame renders: one per spot or directional light, six per
     /// point light (`view::light_views`), from the current frame state.
@@ -151,8 +159,21 @@ impl<'g> Renderer<'g> {
     /// shows `scene.rest_state()`. Whatever was made before an error is freed.
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
         let bounds = scene.bounds().unwrap_or((glam::Vec3::ZERO, glam::Vec3::X));
-        let state = scene.rest_state();
-        let views = all_views(&state, bounds, settings.rsm_resolution);
+        let rest = scene.rest_state();
+        let origin = crate::scene::render_origin(&rest.camera);
+        let state = rest.relative_to(origin);
+        let object_bounds: Vec<(glam::Vec3, glam::Vec3)> = scene
+            .instances
+            .iter()
+            .map(|i| mesh_bounds(&scene.meshes[i.mesh]))
+            .collect();
+        let fitting = ViewFitting {
+            bounds,
+            origin,
+            objects: &object_bounds,
+            size: (settings.width, settings.height),
+        };
+        let views = all_views(&state, &fitting, settings.rsm_resolution);
         let descriptor = check_run(
             gpu,
             settings,
@@ -217,6 +238,8 @@ impl<'g> Renderer<'g> {
             gpu,
             settings: settings.clone(),
             bounds,
+            object_bounds,
+            origin,
             state,
             views,
             only_view: None,
@@ -257,8 +280,15 @@ impl<'g> Renderer<'g> {
                 kinds(&self.state)
             );
         }
-        self.state = state.clone();
-        self.views = all_views(&self.state, self.bounds, self.settings.rsm_resolution);
+        self.origin = crate::scene::render_origin(&state.camera);
+        self.state = state.relative_to(self.origin);
+        let fitting = ViewFitting {
+            bounds: self.bounds,
+            origin: self.origin,
+            objects: &self.object_bounds,
+            size: (self.settings.width, self.settings.height),
+        };
+        self.views = all_views(&self.state, &fitting, self.settings.rsm_resolution);
         Ok(())
     }
 
@@ -275,7 +305,8 @@ impl<'g> Renderer<'g> {
 
     /// The frame uniforms of light view `v` (an index into `light_views`).
     pub fn view_uniforms(&self, v: usize) -> FrameUniforms {
-        frame_uniforms(&self.state, &self.settings, &self.views[v])
+        let bounds = relative(self.bounds, self.origin);
+        frame_uniforms(&self.state, &self.settings, &self.views[v], bounds)
     }
 
     /// The RSMs each frame renders, in order.
@@ -530,17 +561,34 @@ impl<'g> Renderer<'g> {
         Ok(stats)
     }
 
-    /// Copies every output of the last frame back to the host.
+    /// Copies every output of the last frame back to the host, positions
+    /// in world space.
     pub fn readback(&self) -> Result<Readback> {
-        readback::read_frame(self.gpu, &self.targets)
+        let mut r = readback::read_frame(self.gpu, &self.targets)?;
+        readback::to_world(&mut r.position, self.origin);
+        readback::to_world(&mut r.rsm.position, self.origin);
+        Ok(r)
     }
 
-    /// The multiresolution buffer of the last frame, if the method has one.
+    /// What the GPU renders relative to (`scene::render_origin`).
+    pub fn render_origin(&self) -> glam::DVec3 {
+        self.origin
+    }
+
+    /// The multiresolution buffer of the last frame, if the method has one,
+    /// positions in world space.
     pub fn readback_multires(&self) -> Result<Option<MultiresReadback>> {
-        match self.method.multires() {
-            Some(m) => Ok(Some(readback::read_multires(self.gpu, m, &self.targets)?)),
-            None => Ok(None),
+        let Some(m) = self.method.multires() else {
+            return Ok(None);
+        };
+        let mut r = readback::read_multires(self.gpu, m, &self.targets)?;
+        for level in &mut r.geo_mean {
+            readback::to_world(level, self.origin);
         }
+        for level in &mut r.rsm_tree {
+            readback::to_world(&mut level[0], self.origin);
+        }
+        Ok(Some(r))
     }
 
     /// The multiresolution buffer, if the method has one.
@@ -548,23 +596,32 @@ impl<'g> Renderer<'g> {
         self.method.multires()
     }
 
-    /// The light patches Basic ISR chose in the last frame (`None` for other methods).
+    /// The light patches Basic ISR chose in the last frame (`None` for other
+    /// methods), positions in world space.
     pub fn isr_chosen(&self) -> Result<Option<Vec<LightPatch>>> {
-        match self.method.chosen_patches() {
-            Some(b) => Ok(Some(readback::read_chosen_patches(self.gpu, b)?)),
-            None => Ok(None),
+        self.patches(self.method.chosen_patches())
+    }
+
+    /// HISR's packed light tree, root first (`shaders/light_tree_pack.comp`),
+    /// positions in world space.
+    pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
+        self.patches(self.method.packed_light_tree())
+    }
+
+    fn patches(&self, buffer: Option<&Buffer>) -> Result<Option<Vec<LightPatch>>> {
+        let Some(b) = buffer else {
+            return Ok(None);
+        };
+        let mut patches = readback::read_chosen_patches(self.gpu, b)?;
+        let mut positions: Vec<[f32; 4]> = patches.iter().map(|p| p.position_area).collect();
+        readback::to_world(&mut positions, self.origin);
+        for (p, q) in patches.iter_mut().zip(positions) {
+            p.position_area = q;
         }
+        Ok(Some(patches))
     }
 
     /// How many light patches Basic ISR chose in the last frame.
-    /// HISR's packed light tree, root first (`shaders/light_tree_pack.comp`).
-    pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
-        match self.method.packed_light_tree() {
-            Some(b) => Ok(Some(readback::read_chosen_patches(self.gpu, b)?)),
-            None => Ok(None),
-        }
-    }
-
     pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
         Ok(self.isr_chosen()?.map(|c| c.len() as u32))
     }
@@ -608,14 +665,61 @@ fn run_uniforms(d: &dyn Descriptor, s: &RenderSettings) -> RunUniforms {
     u
 }
 
-/// Every light view of `state`'s lights, in light order.
-fn all_views(state: &FrameState, bounds: (glam::Vec3, glam::Vec3), rsm: u32) -> Vec<LightView> {
+/// `bounds` relative to `origin`, widened by a rounding so that they still
+/// hold every relative position.
+fn relative(bounds: (glam::Vec3, glam::Vec3), origin: glam::DVec3) -> (glam::Vec3, glam::Vec3) {
+    let (lo, hi) = (bounds.0.as_dvec3() - origin, bounds.1.as_dvec3() - origin);
+    let pad = (hi - lo).length() * 1e-6;
+    ((lo - pad).as_vec3(), (hi + pad).as_vec3())
+}
+
+/// What the light views are fitted to: the scene's world bounds, the
+/// render origin, each instance's object-space bounds, the image size.
+struct ViewFitting<'a> {
+    bounds: (glam::Vec3, glam::Vec3),
+    origin: glam::DVec3,
+    objects: &'a [(glam::Vec3, glam::Vec3)],
+    size: (u32, u32),
+}
+
+/// Every light view of `state`'s lights (`state` relative to the render
+/// origin), in light order, relative to the origin; directional lights'
+/// RSMs fitted to the view where the scene holds much more
+/// (`view::fit_directional`).
+fn all_views(state: &FrameState, f: &ViewFitting, rsm: u32) -> Vec<LightView> {
+    let bounds = relative(f.bounds, f.origin);
+    let directional = state
+        .lights
+        .iter()
+        .any(|l| l.kind == LightKind::Directional);
+    let boxes: Vec<(glam::Vec3, glam::Vec3)> = match directional {
+        true => f
+            .objects
+            .iter()
+            .zip(&state.instance_transforms)
+            .map(|(b, m)| crate::view::transformed_box(m, *b))
+            .collect(),
+        false => vec![],
+    };
+    let camera = crate::view::camera_view_proj(&state.camera, f.size.0, f.size.1);
     state
         .lights
         .iter()
         .enumerate()
-        .flat_map(|(i, l)| light_views(i, l, bounds, rsm))
+        .flat_map(|(i, l)| {
+            let fit = (l.kind == LightKind::Directional)
+                .then(|| crate::view::fit_directional(l.direction, &boxes, camera, bounds))
+                .flatten();
+            light_views(i, l, bounds, fit.as_ref(), rsm)
+        })
         .collect()
+}
+
+/// A mesh's bounds in its own space (a point at the origin for no vertices).
+fn mesh_bounds(mesh: &crate::scene::Mesh) -> (glam::Vec3, glam::Vec3) {
+    let mut it = mesh.vertices.iter().map(|v| glam::Vec3::from(v.position));
+    let first = it.next().unwrap_or(glam::Vec3::ZERO);
+    it.fold((first, first), |(a, b), p| (a.min(p), b.max(p)))
 }
 
 impl Drop for Renderer<'_> {

@@ -184,6 +184,10 @@ impl Light {
 /// A perspective camera looking down its local -Z.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Rotation and translation only ([`rigid`]): a camera's node may be
+    /// scaled (a scene scaled as a whole scales its camera's node too), but
+    /// its field of view and znear are its own, so the view is the node's
+    /// placement without the scale.
     pub world_from_camera: Mat4,
     /// Vertical field of view, radians.
     pub yfov: f32,
@@ -208,6 +212,49 @@ impl Camera {
     }
 }
 
+/// The rotation and translation of `m`, without its scale: `None` when `m`
+/// is not finite or maps some direction to (nearly) zero (a scale of 0),
+/// so that it has no orientation.
+pub fn rigid(m: Mat4) -> Option<Mat4> {
+    let l = glam::Mat3::from_mat4(m);
+    let lengths = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
+    let det = l.determinant();
+    let regular =
+        lengths.is_finite() && lengths > 0.0 && det.is_finite() && det.abs() > 1e-6 * lengths;
+    if !(regular && m.w_axis.is_finite()) {
+        return None;
+    }
+    let (_, rotation, translation) = m.to_scale_rotation_translation();
+    rotation
+        .is_finite()
+        .then(|| Mat4::from_rotation_translation(rotation.normalize(), translation))
+}
+
+/// The origin the GPU renders relative to, for `camera`: its position
+/// snapped to a grid whose cell is the power of two at or above 64 times
+/// its znear ([`render_origin_cell`]). Positions on the GPU are then what
+/// they would be with the camera near the world's origin, wherever the
+/// scene is, and keep the precision they have there; the origin moves only
+/// when the camera crosses a cell; and a scene moved by whole cells, or
+/// scaled by a power of two (znear with it), renders from exactly the same
+/// (or exactly scaled) numbers.
+pub fn render_origin(camera: &Camera) -> glam::DVec3 {
+    let cell = render_origin_cell(camera.znear);
+    (camera.position().as_dvec3() / cell).round() * cell
+}
+
+/// See [`render_origin`]: the camera is then within 56 znear of the
+/// origin, so geometry it sees (at least znear away) has relative
+/// coordinates no more than about 57 times its distance, a loss of under
+/// 6 bits of float precision at the nearest and less beyond.
+pub fn render_origin_cell(znear: f32) -> f64 {
+    let z = znear as f64 * 64.0;
+    if !(z.is_finite() && z > 0.0) {
+        return 1.0;
+    }
+    2f64.powi(z.log2().ceil() as i32)
+}
+
 /// What changes from frame to frame: where the camera and the light are and
 /// where every mesh instance is. The renderer takes one per frame
 /// (`Renderer::update`); nothing else about the scene changes between frames.
@@ -218,6 +265,37 @@ pub struct FrameState {
     pub lights: Vec<Light>,
     /// World transform of each `Scene::instances` entry, in the same order.
     pub instance_transforms: Vec<Mat4>,
+}
+
+impl FrameState {
+    /// This state with every position taken relative to `origin` (computed
+    /// in f64): what the GPU renders, so that a scene far from the world's
+    /// origin keeps the precision it has near it (`render_origin`).
+    pub fn relative_to(&self, origin: glam::DVec3) -> FrameState {
+        if origin == glam::DVec3::ZERO {
+            return self.clone();
+        }
+        let shift = |p: Vec3| (p.as_dvec3() - origin).as_vec3();
+        let mut camera = self.camera;
+        camera.world_from_camera.w_axis = shift(self.camera.position()).extend(1.0);
+        let to_origin = glam::DMat4::from_translation(-origin);
+        FrameState {
+            camera,
+            lights: self
+                .lights
+                .iter()
+                .map(|l| Light {
+                    position: shift(l.position),
+                    ..*l
+                })
+                .collect(),
+            instance_transforms: self
+                .instance_transforms
+                .iter()
+                .map(|m| (to_origin * m.as_dmat4()).as_mat4())
+                .collect(),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -322,6 +400,85 @@ impl Scene {
             a.apply(t, &mut state);
         }
         state
+    }
+
+    /// [`Self::state_at`], checked for what the loader checks of the rest
+    /// pose, since an animation can break it at some times only: the camera
+    /// has an orientation (no NaN, no scale of 0), every light a finite
+    /// place and direction, every moved instance a finite transform that
+    /// keeps its mesh inside `limit` metres of the origin. The error names
+    /// the time, what is wrong and the channels that move it.
+    pub fn pose_at(&self, t: f32) -> anyhow::Result<FrameState> {
+        self.pose_within(t, limits::Limits::DEFAULT.coordinate)
+    }
+
+    /// [`Self::pose_at`] with the coordinate limit `limit` (m).
+    pub fn pose_within(&self, t: f32, limit: f32) -> anyhow::Result<FrameState> {
+        use animation::Moved;
+        let state = self.state_at(t);
+        let Some(a) = &self.animation else {
+            return Ok(state);
+        };
+        let fail = |what: Moved, problem: String| -> anyhow::Error {
+            let channels = a.channels_moving(what, t);
+            anyhow::anyhow!(
+                "at t = {t} s {problem}; it is moved by {}",
+                if channels.is_empty() {
+                    "no channel (its rest pose)".to_string()
+                } else {
+                    channels.join(", ")
+                }
+            )
+        };
+        if rigid(state.camera.world_from_camera).is_none() {
+            return Err(fail(
+                Moved::Camera,
+                "the camera has no orientation (its transform is not finite or scales to 0)".into(),
+            ));
+        }
+        for (i, l) in state.lights.iter().enumerate() {
+            if !(l.position.is_finite() && l.direction.is_finite()) {
+                return Err(fail(
+                    Moved::Light(i),
+                    format!(
+                        "light {i} is at {} facing {}, not finite",
+                        l.position, l.direction
+                    ),
+                ));
+            }
+        }
+        for &(i, _) in &a.instances {
+            let (Some(inst), Some(m)) = (self.instances.get(i), state.instance_transforms.get(i))
+            else {
+                continue;
+            };
+            let mesh = &self.meshes[inst.mesh];
+            let reach = mesh
+                .vertices
+                .iter()
+                .map(|v| {
+                    m.transform_point3(Vec3::from(v.position))
+                        .abs()
+                        .max_element()
+                })
+                .fold(0.0f32, |r, x| {
+                    if x.is_nan() || r.is_nan() {
+                        f32::NAN
+                    } else {
+                        r.max(x)
+                    }
+                });
+            if !m.is_finite() || reach.is_nan() || reach > limit {
+                return Err(fail(
+                    Moved::Instance(i),
+                    format!(
+                        "instance {i} ({}) reaches {reach:.3e} m from the origin; isr supports coordinates up to {limit:.0e} m",
+                        mesh.name
+                    ),
+                ));
+            }
+        }
+        Ok(state)
     }
 
     /// The latest keyframe time, or `None` for a still scene.

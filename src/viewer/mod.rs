@@ -498,7 +498,9 @@ impl<'g> Viewer<'g> {
             Err(e) => return Err(anyhow!("acquiring a swapchain image: {e}")),
         };
 
-        let mut state = self.scene.state_at(self.time);
+        // An animation that breaks a pose at some time ends the run with
+        // the message that names it, as `isr render` does.
+        let mut state = self.scene.pose_at(self.time)?;
         self.controls.apply(&mut state);
         self.renderer.update(&state)?;
 

@@ -99,7 +99,10 @@ pub fn small_params(mut s: RenderSettings, vpls: u32, isr_base: u32, chunk: u64)
 pub struct Rendered {
     pub readback: Readback,
     pub stats: FrameStats,
+    /// As the GPU saw them: positions relative to `origin`.
     pub uniforms: isr::gpu_types::FrameUniforms,
+    /// The render origin (`isr::scene::render_origin`).
+    pub origin: glam::DVec3,
 }
 
 /// Renders `frames` frames of `scene` and reads the results back, checking
@@ -109,12 +112,14 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) 
     let stats = r.render_frames(frames, |_| {}).expect("rendering");
     let readback = r.readback().expect("readback");
     let uniforms = r.frame_uniforms();
+    let origin = r.render_origin();
     drop(r);
     assert_validation_clean(gpu);
     Rendered {
         readback,
         stats,
         uniforms,
+        origin,
     }
 }
 
@@ -152,15 +157,11 @@ pub fn render_multires(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> R
     }
 }
 
-/// The pixel (x, y) where world point `p` lands, if it is on screen.
-pub fn project(
-    u: &isr::gpu_types::FrameUniforms,
-    width: u32,
-    height: u32,
-    p: Vec3,
-) -> Option<(u32, u32)> {
-    let m = glam::Mat4::from_cols_array_2d(&u.camera_view_proj);
-    let c = m * p.extend(1.0);
+/// The pixel (x, y) of `r` where world point `p` lands, if it is on screen.
+pub fn project(r: &Rendered, p: Vec3) -> Option<(u32, u32)> {
+    let (width, height) = (r.readback.width, r.readback.height);
+    let m = glam::Mat4::from_cols_array_2d(&r.uniforms.camera_view_proj);
+    let c = m * (p.as_dvec3() - r.origin).as_vec3().extend(1.0);
     if c.w <= 0.0 {
         return None;
     }

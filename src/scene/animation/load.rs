@@ -78,7 +78,8 @@ pub fn from_gltf(
                 .collect();
             channels.push(
                 Channel::new(node.index(), property, interpolation, times, values)
-                    .map_err(|e| anyhow!("{label}: {e}"))?,
+                    .map_err(|e| anyhow!("{label}: {e}"))?
+                    .labelled(label.clone()),
             );
         }
     }

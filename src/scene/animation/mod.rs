@@ -80,6 +80,8 @@ pub struct Channel {
     /// Per key a vector (w unused) or a quaternion (xyzw); CUBICSPLINE keys
     /// are three entries: in-tangent, value, out-tangent.
     pub(super) values: Vec<Vec4>,
+    /// How messages name it: "animation 0 (walk) channel 2" from a file.
+    pub(super) label: String,
 }
 
 impl Channel {
@@ -136,19 +138,29 @@ impl Channel {
             // Tangents are derivatives, not rotations: only the values are unit.
             for (i, v) in values.iter_mut().enumerate() {
                 if per_key == 1 || i % 3 == 1 {
-                    *v = v.try_normalize().ok_or_else(|| {
+                    // Scaled by its largest component first: (1e-30, 0, 0,
+                    // 1e-30) is a rotation whose squared length underflows.
+                    let largest = v.abs().max_element();
+                    *v = (*v / largest).try_normalize().ok_or_else(|| {
                         format!("rotation key {} is a zero quaternion", i / per_key)
                     })?;
                 }
             }
         }
+        let label = format!("the {} channel of node {node}", property.name());
         Ok(Self {
             node,
             property,
             interpolation,
             times,
             values,
+            label,
         })
+    }
+
+    /// This channel, named `label` in messages ("animation 0 (walk) channel 2").
+    pub fn labelled(self, label: String) -> Self {
+        Self { label, ..self }
     }
 
     /// The time of the last keyframe.
@@ -338,7 +350,9 @@ impl Animation {
             }
         }
         if let Some(n) = self.camera {
-            state.camera.world_from_camera = world[n];
+            // Without scale, as the loader places it; a pose with no
+            // orientation is NaN, which `Scene::pose_at` refuses.
+            state.camera.world_from_camera = crate::scene::rigid(world[n]).unwrap_or(Mat4::NAN);
         }
         for &(i, n) in &self.lights {
             let Some(l) = state.lights.get_mut(i) else {
@@ -350,6 +364,48 @@ impl Animation {
                 .transform_vector3(-Vec3::Z)
                 .normalize_or(l.direction);
         }
+    }
+}
+
+/// What an animation moves, for messages that name the channels behind it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Moved {
+    Instance(usize),
+    Camera,
+    Light(usize),
+}
+
+impl Animation {
+    /// The channels that move `what` (those of its node and of the nodes
+    /// above it), each described with its value at `t`; empty when the
+    /// animation does not move it.
+    pub fn channels_moving(&self, what: Moved, t: f32) -> Vec<String> {
+        let node = match what {
+            Moved::Instance(i) => self.instances.iter().find(|e| e.0 == i).map(|e| e.1),
+            Moved::Camera => self.camera,
+            Moved::Light(i) => self.lights.iter().find(|e| e.0 == i).map(|e| e.1),
+        };
+        let mut chain = vec![];
+        let mut n = node;
+        while let Some(k) = n {
+            chain.push(k);
+            n = match self.nodes[k].parent {
+                Parent::Node(p) => Some(p),
+                Parent::Fixed(_) => None,
+            };
+        }
+        self.channels
+            .iter()
+            .filter(|c| chain.contains(&c.node))
+            .map(|c| {
+                let v = c.sample(t);
+                let v = match c.property {
+                    Property::Rotation => format!("{:?}", v.to_array()),
+                    _ => format!("{:?}", v.truncate().to_array()),
+                };
+                format!("{} ({} {v} at this time)", c.label, c.property.name())
+            })
+            .collect()
     }
 }
 

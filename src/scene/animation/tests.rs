@@ -300,10 +300,16 @@ fn nested_nodes_compose_parent_then_child() {
     // Instances no node carries stay put.
     assert_eq!(s.instance_transforms[0], Mat4::IDENTITY);
     assert_eq!(s.instance_transforms[2], Mat4::IDENTITY);
-    assert!(s
-        .camera
-        .world_from_camera
-        .abs_diff_eq(parent_m * child_m * offset, 1e-6));
+    // The camera where its node is, without the node's scale of 2 (its
+    // field of view and znear are its own).
+    let node = parent_m * child_m * offset;
+    let rigid = Mat4::from_cols(
+        node.x_axis / 2.0,
+        node.y_axis / 2.0,
+        node.z_axis / 2.0,
+        node.w_axis,
+    );
+    assert!(s.camera.world_from_camera.abs_diff_eq(rigid, 1e-6));
     // The light at the parent's origin, pointing along its -Z.
     assert!(s.lights[0]
         .position

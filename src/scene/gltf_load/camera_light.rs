@@ -21,24 +21,21 @@ pub(super) fn read_camera(
     if !(znear.is_normal() && znear > 0.0) {
         bail!("camera {index}: znear {znear} must be a positive, finite, normal number");
     }
-    if !nonsingular(world) {
+    let Some(world_from_camera) = crate::scene::rigid(world) else {
         bail!(
             "camera {index}: the transform of its node {node} is singular (a scale of 0?), so it has no view direction"
         );
-    }
+    };
     Ok(Camera {
-        world_from_camera: world,
+        world_from_camera,
         yfov,
         znear,
     })
 }
 
-/// The linear part maps no direction to (nearly) zero.
+/// The linear part maps no direction to (nearly) zero (and all is finite).
 pub(super) fn nonsingular(m: Mat4) -> bool {
-    let l = Mat3::from_mat4(m);
-    let lengths = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
-    let det = l.determinant();
-    lengths.is_finite() && lengths > 0.0 && det.is_finite() && det.abs() > 1e-6 * lengths
+    crate::scene::rigid(m).is_some()
 }
 
 /// Reversed-Z with an infinite far plane stores znear / distance: it must not

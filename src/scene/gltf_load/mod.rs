@@ -15,7 +15,7 @@ use super::{
     compute_normals, uri, Camera, GpuVertex, Instance, Material, Mesh, Scene, SpotLight, Texture,
 };
 use anyhow::{anyhow, bail, Context as _, Result};
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
 use std::path::Path;
