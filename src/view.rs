@@ -207,7 +207,7 @@ pub fn fit_directional(
         |(a, b): (Vec3, Vec3), (c, d): (Vec3, Vec3)| a.cmple(d).all() && c.cmple(b).all();
     let footprint = union(&mut instances.iter().copied().filter(|b| overlaps(*b, near)))?;
     let extent = |(a, b): (Vec3, Vec3)| (b - a).length();
-    if !(extent(footprint) * 8.0 < extent(scene)) {
+    if extent(footprint) * 8.0 >= extent(scene) || extent(footprint).is_nan() {
         return None;
     }
     let rot = directional_frame(direction);
@@ -297,18 +297,9 @@ fn directional_view(
     let (za, zb) = transformed_box(&rot, casters);
     let (a, b) = (a.with_z(a.z.min(za.z)), b.with_z(b.z.max(zb.z)));
     // Half a texel of margin on each side so geometry on the bounds is inside.
-    let raw_half = 0.5 * (b.x - a.x).max(b.y - a.y).max(1e-6);
-    // Sized in steps of 2^(1/8) (9%): a square fitted to the view then
-    // changes, and its texels with it, only when the view's reach does by a
-    // step; and a scene with far objects left out covers the same square as
-    // the scene without them.
-    let half = 2f32.powf(
-        (raw_half * (1.0 + 2.0 / r as f32))
-            .log2()
-            .mul_add(8.0, 0.0)
-            .ceil()
-            / 8.0,
-    );
+    let raw_half = 0.5 * (b.x - a.x).max(b.y - a.y).max(f32::MIN_POSITIVE);
+    // A fitted square changes only when the instances in its footprint do.
+    let half = raw_half * (1.0 + 2.0 / r as f32);
     let texel = 2.0 * half / r as f32;
     // Snapped to whole texels from the footprint's corner: a grid fixed to
     // the scene, so it stays put as the camera (and the render origin)

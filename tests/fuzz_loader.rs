@@ -43,6 +43,7 @@ const FUZZ_LIMITS: Limits = Limits {
     triangles: 1 << 15,
     vertices: 1 << 15,
     coordinate: 1e6,
+    min_extent: 1e-6,
 };
 /// More than the budgets above can account for (a few copies of 8 MiB of
 /// buffers, 32k vertices, 256k texels).

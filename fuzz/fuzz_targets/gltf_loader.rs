@@ -29,6 +29,7 @@ fuzz_target!(|data: &[u8]| {
             triangles: 1 << 15,
             vertices: 1 << 15,
             coordinate: 1e6,
+            min_extent: 1e-6,
         },
     };
     if let Ok(scene) = load_bytes(&dir.join(name), file, &options) {

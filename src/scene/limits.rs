@@ -36,6 +36,11 @@ pub struct Limits {
     /// well before that its shadow test loses precision (measured on
     /// lavapipe: correct at 1e6 m, degraded at 3e6, black at 1e7).
     pub coordinate: f32,
+    /// Smallest extent (the diagonal of the geometry's bounds), in metres.
+    /// Images do not depend on a scene's size (`tests/scale.rs`) until its
+    /// areas and squared distances near f32's smallest normal numbers:
+    /// measured correct for a 2 m box scaled by 1e-8, broken at 1e-10.
+    pub min_extent: f32,
 }
 
 impl Limits {
@@ -50,6 +55,7 @@ impl Limits {
         triangles: 1 << 24,
         vertices: 1 << 24,
         coordinate: 1e6,
+        min_extent: 1e-6,
     };
 }
 

@@ -127,7 +127,8 @@ pub(super) fn default_camera() -> Camera {
 /// clamped to the largest f32 (only reached far beyond `Limits::coordinate`).
 pub fn fitted_light(lo: Vec3, hi: Vec3) -> SpotLight {
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
-    let size = (hi - lo).max_element().max(1e-3);
+    // Scale-free: the loader refuses scenes below `Limits::min_extent`.
+    let size = (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let center = (lo + hi) * 0.5;
     let position = glam::DVec3::new(center.x, hi.y - 0.05 * size, center.z);
     let drop = (position.y - lo.y).max(0.1 * size);
@@ -136,7 +137,8 @@ pub fn fitted_light(lo: Vec3, hi: Vec3) -> SpotLight {
         position: position.as_vec3(),
         direction: -Vec3::Y,
         color: Vec3::ONE,
-        intensity: (std::f64::consts::PI * drop * drop).min(f32::MAX as f64) as f32,
+        intensity: (std::f64::consts::PI * drop * drop)
+            .clamp(f32::MIN_POSITIVE as f64, f32::MAX as f64) as f32,
         inner_cone: 45f32.to_radians(),
         outer_cone: 60f32.to_radians(),
         range: None,
@@ -158,7 +160,7 @@ pub fn fitted_camera(lo: Vec3, hi: Vec3) -> Camera {
     // At least a millionth of the distance from the origin, so that the eye
     // is a different f32 from the centre even for a point far out.
     let radius = ((hi - lo).length() * 0.5)
-        .max(1e-3)
+        .max(f64::MIN_POSITIVE)
         .max(center.abs().max_element() * 1e-6);
     let yfov = 45f64.to_radians();
     let distance = radius / (yfov * 0.5).sin();

@@ -200,6 +200,13 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             limits.coordinate
         );
     }
+    let extent = (hi - lo).length();
+    if extent < limits.min_extent {
+        bail!(
+            "the scene is too small: its geometry spans {extent:.3e} m; isr renders in 32-bit floats and supports scenes at least {:.0e} m across (scale the scene up: images do not depend on the scale)",
+            limits.min_extent
+        );
+    }
     lights.sort_by_key(|&(node, _)| node);
     if lights.is_empty() {
         let l = fitted_light(lo, hi);
