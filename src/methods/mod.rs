@@ -16,6 +16,7 @@ pub mod args;
 pub mod gather;
 pub mod hisr;
 pub mod isr;
+pub mod lpv;
 pub mod multires_gather;
 pub mod multires_method;
 pub mod multires_splat;
@@ -47,6 +48,7 @@ pub static REGISTRY: &[&dyn Descriptor] = &[
     &multires_gather::MultiresGatherMethod,
     &isr::IsrMethod,
     &hisr::HisrMethod,
+    &lpv::LpvMethod,
     &reference::ReferenceMethod,
 ];
 

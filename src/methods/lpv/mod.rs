@@ -1,0 +1,217 @@
+//! Method `lpv`: Cascaded Light Propagation Volumes (Kaplanyan & Dachsbacher,
+//! I3D 2010; docs/algorithm.md section 8), on the same RSM, G-buffer and
+//! composite as every other method. Per light view: the RSM's VPLs are
+//! injected into nested grids around the camera as 2-band SH intensities
+//! (`lpv-inject`), propagated to their six neighbours `--lpv-iterations`
+//! times past a geometry volume of blocking potentials (`lpv-propagate`;
+//! the volume from the RSM in `lpv-inject`, from the G-buffer once per frame
+//! in `lpv-geometry`), and every pixel reads irradiance from the finest
+//! cascade that holds it (`lpv-lookup`). Nothing is kept between frames.
+//!
+//! This module declares the method and its parameters; `volume` makes and
+//! records its passes; `grid` is the host's copy of the layout, the
+//! placement and the lookup (what tests compare the GPU with).
+
+pub mod grid;
+pub mod volume;
+
+use super::{Descriptor, IndirectMethod};
+use crate::frame::Setup;
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::{Method, Params, RenderSettings};
+use anyhow::{bail, Result};
+
+pub use volume::Lpv;
+
+pub const KEY: Method = Method::new("lpv");
+
+pub const SIZE: Param<u32> = Param {
+    name: "lpv-size",
+    help: "LPV: cells per side of each cascade",
+    default: DefaultValue::Fixed(32),
+    range: Range::powers_of(2, 8.0, 64.0),
+};
+
+pub const CASCADES: Param<u32> = Param {
+    name: "lpv-cascades",
+    help: "LPV: nested grids around the camera, each twice the side of the one inside it; \
+           the coarsest spans the scene's reach from the camera",
+    default: DefaultValue::Fixed(3),
+    range: Range::closed(1.0, 4.0),
+};
+
+pub const ITERATIONS: Param<u32> = Param {
+    name: "lpv-iterations",
+    help: "LPV: propagation steps; light travels one cell of each cascade per step",
+    default: DefaultValue::Fixed(8),
+    range: Range::closed(0.0, 64.0),
+};
+
+pub const OCCLUSION: Param<bool> = Param {
+    name: "lpv-occlusion",
+    help: "LPV: blocking potentials from the RSM's and the G-buffer's surfels (the \
+           geometry volume) attenuate propagation",
+    default: DefaultValue::Fixed(true),
+    range: Range::ANY,
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&SIZE, &CASCADES, &ITERATIONS, &OCCLUSION];
+
+/// What a run of `s` builds: the derived sizes, from the one place they are
+/// derived.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Cells per side of a cascade.
+    pub size: u32,
+    pub cascades: u32,
+    pub iterations: u32,
+    pub occlusion: bool,
+    /// The RSM quadtree level injected as VPLs (and as the RSM's surfels):
+    /// the level with at most 4 texels per cell side of a cascade's side,
+    /// `log2(R / min(R, 4 size))`, so that the VPLs' density follows the grid
+    /// rather than the RSM (the paper injects a reduced RSM too).
+    pub vpl_level: u32,
+    /// G-buffer pixels per side of one geometry surfel: one in each block,
+    /// standing for the block, about 4 per cell side across the image,
+    /// `max(1, min(W, H) / (4 size))`.
+    pub gbuffer_stride: u32,
+}
+
+impl Layout {
+    pub fn of(s: &RenderSettings) -> Self {
+        let size = SIZE.get(s);
+        let r = s.rsm_resolution;
+        Self {
+            size,
+            cascades: CASCADES.get(s),
+            iterations: ITERATIONS.get(s),
+            occlusion: OCCLUSION.get(s),
+            vpl_level: r.ilog2() - r.min(4 * size).ilog2(),
+            gbuffer_stride: (s.width.min(s.height) / (4 * size)).max(1),
+        }
+    }
+
+    /// Cells of all cascades.
+    pub fn cells(&self) -> u64 {
+        (self.size as u64).pow(3) * self.cascades as u64
+    }
+
+    /// VPLs (and RSM surfels) per side.
+    pub fn vpl_side(&self, rsm_resolution: u32) -> u32 {
+        rsm_resolution >> self.vpl_level
+    }
+
+    /// Geometry surfels taken from the G-buffer of a `width` x `height` image.
+    pub fn gbuffer_surfels(&self, width: u32, height: u32) -> u32 {
+        width.div_ceil(self.gbuffer_stride) * height.div_ceil(self.gbuffer_stride)
+    }
+
+    /// Bytes of GPU memory: the three injection images (RGBA32F), three
+    /// buffers of three SH planes (RGBA32F: the two iterations in flight and
+    /// their sum) and, with occlusion, the two geometry volumes (RGBA32F)
+    /// and their copy as a buffer.
+    pub fn bytes(&self) -> u64 {
+        let cells = self.cells();
+        let geometry = if self.occlusion { 2 * 16 + 2 * 16 } else { 0 };
+        cells * (3 * 16 + 3 * 3 * 16 + geometry)
+    }
+}
+
+pub struct LpvMethod;
+
+impl Descriptor for LpvMethod {
+    fn key(&self) -> Method {
+        KEY
+    }
+    fn color(&self) -> [u8; 3] {
+        [31, 119, 180]
+    }
+    fn help(&self) -> &'static str {
+        "Cascaded light propagation volumes: VPLs in SH grids, propagated to neighbours."
+    }
+    fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
+        &[PARAMS]
+    }
+    fn check(&self, s: &RenderSettings) -> Result<()> {
+        let (n, steps) = (SIZE.get(s), ITERATIONS.get(s));
+        // The longest path between two cells of a cascade is 3 (N - 1) steps.
+        if steps > 3 * (n - 1) {
+            bail!(
+                "--lpv-iterations {steps} with --lpv-size {n}: light crosses a cascade in at \
+                 most {} steps, so more change nothing",
+                3 * (n - 1)
+            );
+        }
+        Ok(())
+    }
+    fn memory(&self, s: &RenderSettings) -> u64 {
+        Layout::of(s).bytes()
+    }
+    fn sweep(&self, _rsm: u32, quick: bool) -> Vec<Params> {
+        sweep(quick)
+    }
+    fn label(&self, s: &RenderSettings) -> String {
+        let l = Layout::of(s);
+        let mut label = format!("{}^3 x {}, {} steps", l.size, l.cascades, l.iterations);
+        if !l.occlusion {
+            label += ", no occlusion";
+        }
+        label
+    }
+    fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
+        Ok(Box::new(Lpv::new(setup)?))
+    }
+}
+
+/// LPV's points in the bench: the grid size (16, 32, 64), the iterations
+/// (4, 8, 16) and occlusion off, each from the default (32^3, 8 steps,
+/// occlusion on); quick: the default, 16^3 and occlusion off.
+fn sweep(quick: bool) -> Vec<Params> {
+    let mut v = vec![
+        Params::new(),
+        Params::new().with(&SIZE, 16),
+        Params::new().with(&OCCLUSION, false),
+    ];
+    if !quick {
+        v.push(Params::new().with(&SIZE, 64));
+        v.push(Params::new().with(&ITERATIONS, 4));
+        v.push(Params::new().with(&ITERATIONS, 16));
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_follows_the_settings() {
+        let s = RenderSettings {
+            width: 256,
+            height: 128,
+            rsm_resolution: 512,
+            ..RenderSettings::DEFAULT
+        }
+        .with_method(KEY);
+        let l = Layout::of(&s);
+        assert_eq!(
+            (l.size, l.cascades, l.iterations, l.occlusion),
+            (32, 3, 8, true)
+        );
+        // 128 VPLs a side: level 2 of 512; 128 / 128 = 1 pixel per surfel.
+        assert_eq!(
+            (l.vpl_level, l.vpl_side(512), l.gbuffer_stride),
+            (2, 128, 1)
+        );
+        assert_eq!(l.bytes(), 32 * 32 * 32 * 3 * (48 + 144 + 64));
+        let small = Layout::of(&RenderSettings {
+            rsm_resolution: 64,
+            ..s.clone()
+        });
+        assert_eq!(small.vpl_level, 0);
+        assert!(LpvMethod.check(&s).is_ok());
+        assert!(LpvMethod
+            .check(&s.clone().with(&ITERATIONS, 64).with(&SIZE, 8))
+            .is_err());
+    }
+}
