@@ -5,6 +5,11 @@
 //! never leaves a truncated file where a good one was. [`check_outputs`]
 //! checks the paths before any rendering, so bad ones fail in a second rather
 //! than after the render.
+//!
+//! An output that is a symbolic link is written through: the new file
+//! replaces the link's target, and the link stays ([`resolve_links`]).
+//! Temporaries are named `.NAME.PID-N.tmp` (shortened with a hash of NAME
+//! where that would pass the file system's name limit).
 
 use crate::readback::Readback;
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -52,9 +57,10 @@ pub fn check_render_outputs(exr: &Path, png: &Path, timings: Option<&Path>) -> R
 }
 
 /// Checks, before any work, that each output can be written where asked: the
-/// extension matches its kind, the path is not a directory or other non-file,
-/// its folder exists or can be created (it is created) and is writable (a
-/// temporary file is created and removed), and no two outputs share a path.
+/// extension matches its kind, the path (through any symbolic links) is not
+/// a directory or other non-file, its folder exists or can be created (it is
+/// created) and is writable (a temporary file is created and removed), its
+/// name is within the file system's limit, and no two outputs share a path.
 pub fn check_outputs(outputs: &[(OutputKind, &Path)]) -> Result<()> {
     let mut seen: Vec<(PathBuf, OutputKind, &Path)> = Vec::new();
     for &(kind, path) in outputs {
@@ -72,44 +78,7 @@ pub fn check_outputs(outputs: &[(OutputKind, &Path)]) -> Result<()> {
                 }
             );
         }
-        if let Ok(meta) = std::fs::metadata(path) {
-            if meta.is_dir() {
-                bail!(
-                    "{} {} is a directory; name a file inside it",
-                    kind.option(),
-                    path.display()
-                );
-            }
-            if !meta.is_file() {
-                bail!(
-                    "{} {} exists and is not a regular file (a device or FIFO?); name a file",
-                    kind.option(),
-                    path.display()
-                );
-            }
-        }
-        let dir = folder(path);
-        std::fs::create_dir_all(&dir).with_context(|| {
-            format!(
-                "{} {}: cannot create its folder {}",
-                kind.option(),
-                path.display(),
-                dir.display()
-            )
-        })?;
-        // Writability is what creating a file there says, not the mode bits
-        // (root, ACLs, read-only mounts).
-        let probe = temp_file(path).with_context(|| {
-            format!(
-                "{} {}: its folder {} is not writable",
-                kind.option(),
-                path.display(),
-                dir.display()
-            )
-        })?;
-        drop(probe.1);
-        let _ = std::fs::remove_file(&probe.0);
-        let key = identity(path)?;
+        let key = check_output(kind.option(), path, None)?;
         if let Some((_, other, other_path)) = seen.iter().find(|(k, _, _)| *k == key) {
             bail!(
                 "{} {} and {} {} are the same file; give each output its own path",
@@ -122,6 +91,66 @@ pub fn check_outputs(outputs: &[(OutputKind, &Path)]) -> Result<()> {
         seen.push((key, kind, path));
     }
     Ok(())
+}
+
+/// The checks of [`check_outputs`] but the extension's for one file,
+/// `label` naming it in messages (`--png`); `remedy` replaces the advice
+/// ("name a file") where the name is not the user's to choose. Returns the
+/// path two spellings of the same file agree on.
+pub fn check_output(label: &str, path: &Path, remedy: Option<&str>) -> Result<PathBuf> {
+    let target = resolve_links(path).with_context(|| format!("{label} {}", path.display()))?;
+    // What the messages call the file: the path given, and where a link
+    // leads, the target too.
+    let named = if target == path {
+        format!("{label} {}", path.display())
+    } else {
+        format!(
+            "{label} {} (a link to {})",
+            path.display(),
+            target.display()
+        )
+    };
+    if let Ok(meta) = std::fs::metadata(&target) {
+        if meta.is_dir() {
+            bail!(
+                "{named} is a directory; {}",
+                remedy.unwrap_or("name a file inside it")
+            );
+        }
+        if !meta.is_file() {
+            bail!(
+                "{named} exists and is not a regular file (a device or FIFO?); {}",
+                remedy.unwrap_or("name a file")
+            );
+        }
+    }
+    let dir = folder(&target);
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("{named}: cannot create its folder {}", dir.display()))?;
+    let name_bytes = target.file_name().map_or(0, |n| n.len());
+    let max = name_max(&dir);
+    if name_bytes > max {
+        bail!(
+            "{named}: the file name is {name_bytes} bytes long; the file system of {} allows at \
+             most {max}",
+            dir.display()
+        );
+    }
+    // Writability is what creating a file there says, not the mode bits
+    // (root, ACLs, read-only mounts).
+    let probe = match temp_file(&target) {
+        Ok(probe) => probe,
+        Err(e) if name_too_long(&e) => return Err(e.context(named)),
+        Err(e) => {
+            return Err(e.context(format!(
+                "{named}: its folder {} is not writable",
+                dir.display()
+            )))
+        }
+    };
+    drop(probe.1);
+    forget_temporary(&probe.0, true);
+    identity(&target)
 }
 
 /// Checks, before any work, that `--sequence DIR` is a folder (created if
@@ -138,7 +167,7 @@ pub fn check_sequence_dir(dir: &Path) -> Result<()> {
     let probe = temp_file(&dir.join("frame_0000.exr"))
         .with_context(|| format!("--sequence {}: the folder is not writable", dir.display()))?;
     drop(probe.1);
-    let _ = std::fs::remove_file(&probe.0);
+    forget_temporary(&probe.0, true);
     Ok(())
 }
 
@@ -165,6 +194,79 @@ fn identity(path: &Path) -> Result<PathBuf> {
     Ok(dir.join(name))
 }
 
+/// The path `path` writes to: itself, or where its chain of symbolic links
+/// ends (a target that does not exist yet included: it is created, as a
+/// shell's `>` would). Only the last component is followed here; links in
+/// the folders are the system's to follow.
+pub fn resolve_links(path: &Path) -> Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    // Linux's own limit on links followed in one lookup.
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = std::fs::read_link(&p)
+                    .with_context(|| format!("cannot read the symbolic link {}", p.display()))?;
+                // An absolute target replaces the folder.
+                p = folder(&p).join(target);
+            }
+            _ => return Ok(p),
+        }
+    }
+    bail!("too many levels of symbolic links")
+}
+
+/// The longest file name `dir`'s file system takes, in bytes.
+fn name_max(dir: &Path) -> usize {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt as _;
+        if let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_bytes()) {
+            // SAFETY: a valid NUL-terminated path; pathconf only reads it.
+            let n = unsafe { libc::pathconf(c.as_ptr(), libc::_PC_NAME_MAX) };
+            if n > 0 {
+                return n as usize;
+            }
+        }
+    }
+    255
+}
+
+/// The temporary's name for file `name` (extension `ext`): `.NAME.PID-N.tmp`,
+/// or where that is longer than `max` bytes, NAME cut short (at a character)
+/// and followed by a hash of the whole name and its extension,
+/// `.NAM~HASH.EXT.PID-N.tmp`, within `max`.
+fn temp_name(name: &str, ext: &str, pid: u32, n: u32, max: usize) -> String {
+    let plain = format!(".{name}.{pid}-{n}.tmp");
+    if plain.len() <= max {
+        return plain;
+    }
+    // FNV-1a: stable across runs and Rust versions, enough to tell names apart
+    // (the PID and counter make the temporary unique anyway).
+    let hash = name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    });
+    let tail = format!("~{hash:016x}.{ext}.{pid}-{n}.tmp");
+    let mut cut = max.saturating_sub(1 + tail.len()).min(name.len());
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}{tail}", &name[..cut])
+}
+
+/// Done with temporary `tmp` (renamed into place, or removed when `remove`).
+fn forget_temporary(tmp: &Path, remove: bool) {
+    if remove {
+        let _ = std::fs::remove_file(tmp);
+    }
+}
+
+/// Whether `e` says a file name was too long.
+fn name_too_long(e: &anyhow::Error) -> bool {
+    e.chain()
+        .filter_map(|c| c.downcast_ref::<std::io::Error>())
+        .any(|e| e.kind() == std::io::ErrorKind::InvalidFilename)
+}
+
 /// A new file next to `path` (same folder, so the rename cannot cross file
 /// systems), created exclusively so it never clobbers anything.
 fn temp_file(path: &Path) -> Result<(PathBuf, std::fs::File)> {
@@ -174,9 +276,12 @@ fn temp_file(path: &Path) -> Result<(PathBuf, std::fs::File)> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .ok_or_else(|| anyhow!("{} does not name a file", path.display()))?;
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let max = name_max(&dir);
     loop {
         let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.{}-{n}.tmp", std::process::id()));
+        let tmp_name = temp_name(&name, ext, std::process::id(), n, max);
+        let tmp = dir.join(&tmp_name);
         match std::fs::OpenOptions::new()
             .write(true)
             .create_new(true)
@@ -184,19 +289,32 @@ fn temp_file(path: &Path) -> Result<(PathBuf, std::fs::File)> {
         {
             Ok(f) => return Ok((tmp, f)),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(anyhow!("cannot create a file in {}: {e}", dir.display())),
+            Err(e) if e.kind() == std::io::ErrorKind::InvalidFilename => {
+                return Err(anyhow::Error::new(e).context(format!(
+                    "the temporary file name {tmp_name} ({} bytes) is too long for the file \
+                     system of {}",
+                    tmp_name.len(),
+                    dir.display()
+                )))
+            }
+            Err(e) => {
+                return Err(anyhow::Error::new(e)
+                    .context(format!("cannot create a file in {}", dir.display())))
+            }
         }
     }
 }
 
 /// Writes `path` through `write` on a temporary file that is synced and then
 /// renamed into place; on any error the temporary file is removed and `path`
-/// is untouched.
+/// is untouched. A `path` that is a symbolic link is written through: its
+/// target is replaced and the link kept.
 pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<()>,
 ) -> Result<()> {
-    let dir = folder(path);
+    let target = resolve_links(path).with_context(|| format!("cannot write {}", path.display()))?;
+    let dir = folder(&target);
     std::fs::create_dir_all(&dir).with_context(|| {
         format!(
             "cannot create directory {} for {}",
@@ -204,14 +322,14 @@ pub fn write_atomic(
             path.display()
         )
     })?;
-    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+    if std::fs::metadata(&target).is_ok_and(|m| !m.is_file()) {
         bail!(
             "cannot write {}: it exists and is not a regular file",
             path.display()
         );
     }
     let (tmp, file) =
-        temp_file(path).with_context(|| format!("cannot write {}", path.display()))?;
+        temp_file(&target).with_context(|| format!("cannot write {}", path.display()))?;
     let result = (|| {
         let mut w = std::io::BufWriter::new(file);
         write(&mut w)?;
@@ -219,13 +337,11 @@ pub fn write_atomic(
         let file = w.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
         drop(file);
-        std::fs::rename(&tmp, path)?;
+        std::fs::rename(&tmp, &target)?;
         Ok(())
     })();
-    result.map_err(|e: anyhow::Error| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow!("cannot write {}: {e:#}", path.display())
-    })
+    forget_temporary(&tmp, result.is_err());
+    result.map_err(|e: anyhow::Error| anyhow!("cannot write {}: {e:#}", path.display()))
 }
 
 /// Text (the timings JSON) written as [`write_atomic`] does.

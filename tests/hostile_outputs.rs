@@ -178,3 +178,82 @@ fn out_of_memory_mid_sequence_names_the_frames_kept() {
     let e = with_fault(&dir, "melt:1", &[]);
     assert!(e.contains("ISR_INJECT_FAULT=melt:1"), "{e}");
 }
+
+/// Issue 29, item 9: an output that is a symbolic link is written through
+/// to its target (the link stays a link), also when the target does not
+/// exist yet; two outputs whose links meet are one file.
+#[cfg(unix)]
+#[test]
+fn outputs_through_symbolic_links_write_the_target() {
+    let dir = temp_dir("out-symlink");
+    std::fs::create_dir_all(dir.join("real")).unwrap();
+    std::fs::write(dir.join("real/target.exr"), b"old").unwrap();
+    std::os::unix::fs::symlink("real/target.exr", dir.join("link.exr")).unwrap();
+    // A link to a link to a file that does not exist yet.
+    std::os::unix::fs::symlink("real/new.png", dir.join("hop.png")).unwrap();
+    std::os::unix::fs::symlink("hop.png", dir.join("link.png")).unwrap();
+    Isr::tiny(&dir)
+        .args(["--out", "link.exr", "--png", "link.png"])
+        .succeeds();
+    for (link, target) in [
+        ("link.exr", "real/target.exr"),
+        ("link.png", "hop.png"),
+        ("hop.png", "real/new.png"),
+    ] {
+        let meta = std::fs::symlink_metadata(dir.join(link)).unwrap();
+        assert!(meta.file_type().is_symlink(), "{link} was replaced");
+        assert_eq!(
+            std::fs::read_link(dir.join(link)).unwrap(),
+            Path::new(target)
+        );
+    }
+    exr::prelude::read_all_data_from_file(dir.join("real/target.exr"))
+        .expect("the link's target holds the new image");
+    image::open(dir.join("real/new.png")).expect("the dangling link's target was created");
+    let left: Vec<_> = std::fs::read_dir(dir.join("real"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "temporary files left: {left:?}");
+    // A dangling link and the file it names are the same output.
+    std::os::unix::fs::symlink("real/y.exr", dir.join("x.png")).unwrap();
+    let e = Isr::tiny(&dir)
+        .args(["--out", "real/y.exr", "--png", "x.png"])
+        .fails();
+    assert!(e.contains("are the same file"), "{e}");
+    before_rendering(&e);
+}
+
+/// Issue 29, item 10: a file name the file system takes is written however
+/// long (the temporary's name is kept within the limit); one it cannot take
+/// is refused before rendering, saying that the name is too long.
+#[test]
+fn long_output_names_are_written_or_refused_as_too_long() {
+    let dir = temp_dir("out-long-name");
+    let name = format!("{}.exr", "a".repeat(250));
+    assert_eq!(name.len(), 254);
+    Isr::tiny(&dir)
+        .args(["--png", "p.png"])
+        .arg("--out")
+        .arg(&name)
+        .succeeds();
+    exr::prelude::read_all_data_from_file(dir.join(&name)).unwrap();
+    // Multi-byte characters: 127 two-byte ones and ".png", 258 bytes.
+    let accented = format!("{}.png", "é".repeat(127));
+    let e = Isr::tiny(&dir)
+        .args(["--out", "o.exr"])
+        .arg("--png")
+        .arg(&accented)
+        .fails();
+    assert!(
+        e.contains("the file name is 258 bytes long") && e.contains("at most 255"),
+        "{e}"
+    );
+    assert!(!e.contains("not writable"), "{e}");
+    before_rendering(&e);
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "temporary files left: {left:?}");
+}
