@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use options::{MethodArg, RunArgs};
 use std::path::PathBuf;
 
+mod interrupt;
 mod options;
 mod runs;
 mod view;
@@ -178,9 +179,16 @@ enum DebugView {
 /// Parses `std::env::args` and runs the command.
 pub fn run() -> Result<()> {
     let cli = Cli::parse();
+    interrupt::install()?;
     match cli.command {
         Command::Render(args) => render(*args),
-        Command::Bench(args) => crate::bench::cli(&args),
+        Command::Bench(args) => {
+            interrupt::set_note(format!(
+                "the rows finished are kept in {}; the same command resumes from them",
+                args.out_dir.join("rows.jsonl").display()
+            ));
+            crate::bench::cli(&args)
+        }
         Command::View(args) => view::view(*args),
         Command::Devices => devices(),
         Command::ExportBuiltin { path } => {

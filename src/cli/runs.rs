@@ -100,6 +100,12 @@ pub(super) fn sequence(
         }
     }
     let bar = crate::progress::bar(args.frames as u64, "frames");
+    // What an interruption leaves (`interrupt`): the frames before the one
+    // in progress, and no timings.json or GIF of this run.
+    super::interrupt::set_note(format!(
+        "no frame in {} is complete; timings.json was not written",
+        dir.display()
+    ));
     for k in 0..args.frames {
         let t = args.run.time + k as f32 / args.fps;
         renderer.update(&args.state_at(scene, t)?)?;
@@ -125,6 +131,14 @@ pub(super) fn sequence(
         let png = dir.join(format!("frame_{k:04}.png"));
         output::write_exr(&exr, &result)?;
         output::write_png(&png, result.width, result.height, &result.display)?;
+        super::interrupt::set_note(format!(
+            "{} in {} complete; timings.json was not written",
+            match k {
+                0 => "frame 0000 is".to_string(),
+                _ => format!("frames 0000 to {k:04} are"),
+            },
+            dir.display()
+        ));
         if args.gif {
             gif_frames.push(result.display);
         }
@@ -137,6 +151,15 @@ pub(super) fn sequence(
     let path = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": reports }))?;
     output::write_text(&path, &text)?;
+    super::interrupt::set_note(format!(
+        "every frame and timings.json in {} are complete{}",
+        dir.display(),
+        if args.gif {
+            "; sequence.gif was not written"
+        } else {
+            ""
+        }
+    ));
     println!(
         "wrote {} frames ({}/frame_0000.exr ...) and {}",
         args.frames,

@@ -16,6 +16,17 @@ pub const HANG_GUARD: Duration = Duration::from_secs(300);
 pub struct Isr {
     cmd: Command,
     line: Vec<String>,
+    guard: Duration,
+}
+
+/// A run in progress ([`Isr::spawn`]): signal it, then wait for it.
+pub struct Running {
+    child: std::process::Child,
+    stdout: std::thread::JoinHandle<String>,
+    stderr: std::thread::JoinHandle<String>,
+    started: Instant,
+    guard: Duration,
+    line: String,
 }
 
 /// What one run did.
@@ -37,6 +48,7 @@ impl Isr {
         Isr {
             cmd,
             line: vec![subcommand.into()],
+            guard: HANG_GUARD,
         }
     }
 
@@ -78,8 +90,20 @@ impl Isr {
         self
     }
 
-    /// Runs to the end (or to `HANG_GUARD`, which fails the test).
-    pub fn run(mut self) -> Ran {
+    /// Kills the run after `guard` instead of [`HANG_GUARD`] (a run that
+    /// should end in seconds but might hang: a guard, still not asserted).
+    pub fn hang_guard(mut self, guard: Duration) -> Isr {
+        self.guard = guard;
+        self
+    }
+
+    /// Runs to the end (or to the hang guard, which fails the test).
+    pub fn run(self) -> Ran {
+        self.spawn().wait()
+    }
+
+    /// Starts the run and returns at once.
+    pub fn spawn(mut self) -> Running {
         let line = self.line.join(" ");
         let mut child = self
             .cmd
@@ -97,23 +121,12 @@ impl Isr {
         };
         let stdout = read(Box::new(child.stdout.take().unwrap()));
         let stderr = read(Box::new(child.stderr.take().unwrap()));
-        let started = Instant::now();
-        let (status, peak_kib) = loop {
-            if let Some(done) = reap(&mut child) {
-                break done;
-            }
-            if started.elapsed() > HANG_GUARD {
-                let _ = child.kill();
-                let _ = reap_blocking(&mut child);
-                panic!("isr {line} hung: killed after {HANG_GUARD:?}");
-            }
-            std::thread::sleep(Duration::from_millis(5));
-        };
-        Ran {
-            status,
-            stdout: stdout.join().unwrap(),
-            stderr: stderr.join().unwrap(),
-            peak_kib,
+        Running {
+            child,
+            stdout,
+            stderr,
+            started: Instant::now(),
+            guard: self.guard,
             line,
         }
     }
@@ -133,6 +146,59 @@ impl Isr {
     /// Runs and expects a clean failure ([`Ran::clean_failure`]); returns stderr.
     pub fn fails(self) -> String {
         self.run().clean_failure()
+    }
+}
+
+impl Running {
+    /// Whether the run has ended (it is not reaped: [`Running::wait`] still
+    /// returns its status).
+    pub fn has_ended(&self) -> bool {
+        // SAFETY: waitid with WNOWAIT only reads the child's state.
+        #[cfg(target_os = "linux")]
+        unsafe {
+            let mut info: libc::siginfo_t = std::mem::zeroed();
+            let r = libc::waitid(
+                libc::P_PID,
+                self.child.id(),
+                &mut info,
+                libc::WEXITED | libc::WNOHANG | libc::WNOWAIT,
+            );
+            r == 0 && info.si_pid() != 0
+        }
+        #[cfg(not(target_os = "linux"))]
+        false
+    }
+
+    /// Sends signal `signal` (`libc::SIGINT`, ...) to the run.
+    #[cfg(unix)]
+    pub fn signal(&self, signal: i32) {
+        // SAFETY: kill has no memory effects; the child is not yet reaped,
+        // so its PID is still its own.
+        let r = unsafe { libc::kill(self.child.id() as i32, signal) };
+        assert_eq!(r, 0, "kill: {}", std::io::Error::last_os_error());
+    }
+
+    /// Waits for the end (or the hang guard, which fails the test).
+    pub fn wait(mut self) -> Ran {
+        let line = self.line;
+        let (status, peak_kib) = loop {
+            if let Some(done) = reap(&mut self.child) {
+                break done;
+            }
+            if self.started.elapsed() > self.guard {
+                let _ = self.child.kill();
+                let _ = reap_blocking(&mut self.child);
+                panic!("isr {line} hung: killed after {:?}", self.guard);
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        Ran {
+            status,
+            stdout: self.stdout.join().unwrap(),
+            stderr: self.stderr.join().unwrap(),
+            peak_kib,
+            line,
+        }
     }
 }
 
