@@ -261,12 +261,72 @@ pub struct Outcome {
     pub driver: String,
 }
 
+/// The images of `spec` that the gallery shows, written by [`run_scene`] at
+/// the middle animation frame: the reference's and, per method with a
+/// default point, that point's image and FLIP map.
+fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
+    let images = plan.out_dir.join("images").join(&spec.name);
+    let mut files = vec![images.join("reference.png")];
+    for c in plan.configs().iter().filter(|c| c.is_default(&plan.base)) {
+        let m = c.method.name();
+        files.push(images.join(format!("{m}.png")));
+        files.push(images.join(format!("{m}-error.png")));
+    }
+    files
+}
+
+/// Whether the gallery images of point `c` of `spec` (or, without one, the
+/// reference's) are all there.
+fn images_present(plan: &Plan, spec: &SceneSpec, c: Option<&Config>) -> bool {
+    let images = plan.out_dir.join("images").join(&spec.name);
+    let names = match c {
+        None => vec!["reference.png".to_string()],
+        Some(c) => {
+            let m = c.method.name();
+            vec![format!("{m}.png"), format!("{m}-error.png")]
+        }
+    };
+    names.iter().all(|n| images.join(n).is_file())
+}
+
+/// Checks, before any work, every file the run reads or writes in its
+/// folder as `isr render` checks its outputs (`output::check_output`):
+/// regular files only (a link is followed to its target), their folders
+/// creatable and writable. A link to `/dev/null` or a FIFO named
+/// `rows.jsonl` is refused by name instead of failing mid-run or waiting
+/// for ever.
+fn check_outputs(plan: &Plan) -> Result<()> {
+    let dir = &plan.out_dir;
+    let remedy = format!(
+        "remove it, or choose another --out-dir than {}",
+        dir.display()
+    );
+    let mut files: Vec<PathBuf> = std::iter::once("rows.jsonl")
+        .chain(report::FILES.iter().copied())
+        .map(|n| dir.join(n))
+        .collect();
+    for s in &plan.scenes {
+        files.extend(gallery_images(plan, s));
+    }
+    for f in files {
+        crate::output::check_output("bench output", &f, Some(&remedy))?;
+    }
+    Ok(())
+}
+
 /// Runs the plan: renders what the journal lacks, then writes every output.
+/// A point whose row is in the journal but whose gallery images are missing
+/// is rendered again for the images alone; its row stays as measured.
 pub fn run(plan: &Plan) -> Result<Outcome> {
     let dir = &plan.out_dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let journal = dir.join("rows.jsonl");
-    let done = rows::done_keys(&rows::read_journal(&journal)?);
+    check_outputs(plan)?;
+    let found = rows::read_journal(&journal)?;
+    for w in found.warnings(&journal) {
+        eprintln!("{w}");
+    }
+    let done = rows::done_keys(&found.rows);
     let gpu = Gpu::new(&GpuOptions {
         device_index: plan.device,
         ..Default::default()
@@ -274,28 +334,50 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     crate::bench::charts::register_font();
     // Work units: one per frame rendered (reference and every pending point).
     let configs = plan.configs();
-    let mut pending: Vec<(SceneSpec, Vec<Config>, bool)> = vec![];
+    let mut pending: Vec<(SceneSpec, Pending)> = vec![];
     let mut units = 0u64;
+    let image_frames = plan.frames / 2 + 1;
     for s in &plan.scenes {
-        let todo: Vec<Config> = configs
+        let is_done =
+            |c: &Config| done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base)));
+        let todo: Vec<Config> = configs.iter().filter(|c| !is_done(c)).cloned().collect();
+        let redraw: Vec<Config> = configs
             .iter()
-            .filter(|c| !done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base))))
+            .filter(|c| is_done(c) && c.is_default(&plan.base))
+            .filter(|c| !images_present(plan, s, Some(c)))
             .cloned()
             .collect();
         let ref_row = !done.contains(&plan.key(&s.name, "reference", REFERENCE_LABEL));
-        if todo.is_empty() && !ref_row {
+        if todo.is_empty() && !ref_row && redraw.is_empty() && images_present(plan, s, None) {
             continue;
         }
-        units += plan.frames as u64 * (todo.len() as u64 + 1);
-        pending.push((s.clone(), todo, ref_row));
+        // The reference's every frame where a point is measured; up to the
+        // gallery's frame where only images are drawn again.
+        let ref_frames = if todo.is_empty() && !ref_row {
+            image_frames
+        } else {
+            plan.frames
+        };
+        units += ref_frames as u64
+            + plan.frames as u64 * todo.len() as u64
+            + image_frames as u64 * redraw.len() as u64;
+        pending.push((
+            s.clone(),
+            Pending {
+                todo,
+                redraw,
+                ref_row,
+                ref_frames,
+            },
+        ));
     }
     let bar = crate::progress::bar(units, "frames");
-    for (spec, todo, ref_row) in &pending {
+    for (spec, work) in &pending {
         let scene = spec.load()?;
-        run_scene(plan, &gpu, spec, &scene, todo, *ref_row, &journal, &bar)?;
+        run_scene(plan, &gpu, spec, &scene, work, &journal, &bar)?;
     }
     bar.finish_and_clear();
-    let all = rows::read_journal(&journal)?;
+    let all = rows::read_journal(&journal)?.rows;
     let rows: Vec<Row> = plan
         .keys()
         .iter()
@@ -308,6 +390,18 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     };
     report::write_all(plan, &outcome)?;
     Ok(outcome)
+}
+
+/// What a scene of the run still needs.
+struct Pending {
+    /// Points to measure (not in the journal).
+    todo: Vec<Config>,
+    /// Default points in the journal whose gallery images are missing.
+    redraw: Vec<Config>,
+    /// Whether the reference's row is to be written.
+    ref_row: bool,
+    /// Animation frames of the reference to render.
+    ref_frames: u32,
 }
 
 /// `isr bench`: plans, runs, prints where the results are and the ratios.
@@ -327,17 +421,16 @@ fn frame_time(spec: &SceneSpec, k: u32) -> f32 {
     spec.start + k as f32 / spec.fps
 }
 
-#[allow(clippy::too_many_arguments)]
 fn run_scene(
     plan: &Plan,
     gpu: &Gpu,
     spec: &SceneSpec,
     scene: &Scene,
-    todo: &[Config],
-    ref_row: bool,
+    work: &Pending,
     journal: &Path,
     bar: &indicatif::ProgressBar,
 ) -> Result<()> {
+    let ref_row = work.ref_row;
     let images = plan.out_dir.join("images").join(&spec.name);
     // The dense reference of every frame, once.
     let mut refs = Vec::with_capacity(plan.frames as usize);
@@ -345,12 +438,12 @@ fn run_scene(
     {
         let settings = settings_of(plan, REFERENCE);
         let mut r = Renderer::new(gpu, scene, &settings)?;
-        for k in 0..plan.frames {
+        for k in 0..work.ref_frames {
             bar.set_message(format!(
                 "{}: reference, frame {}/{}",
                 spec.name,
                 k + 1,
-                plan.frames
+                work.ref_frames
             ));
             r.update(&scene.pose_at(frame_time(spec, k))?)?;
             let last = k + 1 == plan.frames;
@@ -385,7 +478,14 @@ fn run_scene(
         let _none = Renderer::new(gpu, scene, &settings_of(plan, crate::methods::none::KEY))?;
         allocated_bytes(gpu)
     };
-    for c in todo {
+    let points = work.todo.iter().map(|c| (c, true));
+    for (c, measure) in points.chain(work.redraw.iter().map(|c| (c, false))) {
+        // A point drawn again for its images renders up to their frame.
+        let frames = if measure {
+            plan.frames
+        } else {
+            plan.frames / 2 + 1
+        };
         let settings = c.settings(&plan.base);
         let label = c.label(&plan.base);
         let mut r = Renderer::new(gpu, scene, &settings)
@@ -399,16 +499,20 @@ fn run_scene(
         let mut flicker_final = metrics::Flicker::default();
         let (mut e_ind, mut e_fin, mut e_flip) = (0.0, 0.0, 0.0);
         let mut evals = None;
-        for k in 0..plan.frames {
+        for k in 0..frames {
             bar.set_message(format!(
-                "{}: {} {label}, frame {}/{}",
+                "{}: {} {label}, frame {}/{frames}{}",
                 spec.name,
                 c.method.name(),
                 k + 1,
-                plan.frames
+                if measure { "" } else { " (images only)" }
             ));
             r.update(&scene.pose_at(frame_time(spec, k))?)?;
-            let n = if k == 0 { plan.timing_frames } else { 1 };
+            let n = if k == 0 && measure {
+                plan.timing_frames
+            } else {
+                1
+            };
             // Every frame times but the run's last, which counts (`Profiler`).
             let last = k + 1 == plan.frames;
             stats.extend(r.render_frames_counting(n, last, |_| {})?);
@@ -453,6 +557,9 @@ fn run_scene(
                 )?;
             }
             bar.inc(1);
+        }
+        if !measure {
+            continue;
         }
         let f = plan.frames as f64;
         let mut row = timing_row(plan, spec, &settings, &stats);

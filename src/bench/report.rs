@@ -267,6 +267,21 @@ flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (se
     md
 }
 
+/// The files [`write_all`] writes into the run's folder (checked before a
+/// run begins, with `rows.jsonl` and the gallery's images).
+pub const FILES: &[&str] = &[
+    "results.json",
+    "results.csv",
+    "speed_vs_error.svg",
+    "speed_vs_error.png",
+    "flicker.svg",
+    "flicker.png",
+    "passes.svg",
+    "passes.png",
+    "gallery.png",
+    "report.md",
+];
+
 /// Writes every output of a run into its folder.
 pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
     let dir = &plan.out_dir;

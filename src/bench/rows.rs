@@ -49,28 +49,71 @@ pub struct Row {
     pub gpu_memory_bytes: Option<i64>,
 }
 
-/// The rows already finished in `path` (a missing file is an empty journal;
-/// a line cut off by an interruption is skipped).
-pub fn read_journal(path: &Path) -> Result<Vec<Row>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(vec![]),
+/// What [`read_journal`] found: the rows, and the lines it skipped.
+#[derive(Debug, Default)]
+pub struct Journal {
+    pub rows: Vec<Row>,
+    /// Each line that is not a row (cut off by an interruption, or any
+    /// other bytes): its number from 1 and why.
+    pub skipped: Vec<(usize, String)>,
+}
+
+impl Journal {
+    /// One line per skipped line of `path`, for stderr.
+    pub fn warnings(&self, path: &Path) -> Vec<String> {
+        self.skipped
+            .iter()
+            .map(|(n, why)| {
+                format!(
+                    "warning: {} line {n} is skipped ({why}); its row, if any, is measured again",
+                    path.display()
+                )
+            })
+            .collect()
+    }
+}
+
+/// The rows already finished in `path` (a missing file is an empty journal).
+/// A line that is not a row, whatever its bytes (a line cut off by an
+/// interruption, even inside a character), is skipped and listed.
+pub fn read_journal(path: &Path) -> Result<Journal> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Journal::default()),
         Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
     };
-    Ok(text
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect())
+    let mut journal = Journal::default();
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if line.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        let why = match std::str::from_utf8(line) {
+            Err(_) => "not valid UTF-8: cut off, or not written by isr bench".to_string(),
+            Ok(text) => match serde_json::from_str::<Row>(text) {
+                Ok(row) => {
+                    journal.rows.push(row);
+                    continue;
+                }
+                Err(e) if e.is_eof() => "cut off".to_string(),
+                Err(e) => format!("not a row: {e}"),
+            },
+        };
+        journal.skipped.push((i + 1, why));
+    }
+    Ok(journal)
 }
 
 /// Appends `row` as one line and flushes it to disk, so an interruption
 /// keeps it.
 pub fn append(path: &Path, row: &Row) -> Result<()> {
+    append_line(path, row).with_context(|| format!("cannot append a row to {}", path.display()))
+}
+
+fn append_line(path: &Path, row: &Row) -> Result<()> {
     let mut f = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
-        .open(path)
-        .with_context(|| format!("cannot open {}", path.display()))?;
+        .open(path)?;
     let mut line = serde_json::to_string(row)?;
     line.push('\n');
     // After an interrupted write the last line is torn: start a new one.
@@ -235,7 +278,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("rows.jsonl");
         let _ = std::fs::remove_file(&path);
-        assert!(read_journal(&path).unwrap().is_empty());
+        assert!(read_journal(&path).unwrap().rows.is_empty());
         append(&path, &row("a")).unwrap();
         append(&path, &row("b")).unwrap();
         // An interrupted write leaves half a line.
@@ -246,9 +289,29 @@ mod tests {
             .write_all(b"{\"key\": \"c\", \"sce")
             .unwrap();
         append(&path, &row("d")).unwrap();
-        let rows = read_journal(&path).unwrap();
-        assert_eq!(rows, vec![row("a"), row("b"), row("d")]);
-        assert_eq!(done_keys(&rows).len(), 3);
+        let journal = read_journal(&path).unwrap();
+        assert_eq!(journal.rows, vec![row("a"), row("b"), row("d")]);
+        assert_eq!(done_keys(&journal.rows).len(), 3);
+        assert_eq!(journal.skipped, [(3, "cut off".to_string())]);
+        // Cut inside a character, then bytes that are not UTF-8 at all.
+        let mut r = row("é");
+        r.scene = "café".into();
+        append(&path, &r).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let cut = bytes.windows(2).rposition(|w| w == "é".as_bytes()).unwrap() + 1;
+        bytes.truncate(cut);
+        assert!(std::str::from_utf8(&bytes).is_err());
+        bytes.extend_from_slice(b"\n\xff\xfe\n{\"key\": 1}\n");
+        std::fs::write(&path, &bytes).unwrap();
+        append(&path, &row("e")).unwrap();
+        let journal = read_journal(&path).unwrap();
+        assert_eq!(journal.rows, vec![row("a"), row("b"), row("d"), row("e")]);
+        let lines: Vec<usize> = journal.skipped.iter().map(|s| s.0).collect();
+        assert_eq!(lines, [3, 5, 6, 7], "{:?}", journal.skipped);
+        assert!(journal.skipped[1].1.starts_with("not valid UTF-8"));
+        assert!(journal.skipped[3].1.starts_with("not a row"));
+        let w = journal.warnings(&path);
+        assert!(w[1].contains("rows.jsonl line 5 is skipped"), "{w:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
