@@ -124,3 +124,30 @@ fn no_vulkan_device_says_how_to_install_a_driver() {
         "the message should say how to install a driver:\n{e}"
     );
 }
+
+/// Issue 29, item 11: a size refused for memory says the rule (the share of
+/// the heap a run may take), and its numbers agree with the refusal.
+#[test]
+fn a_memory_refusal_states_the_share_of_the_heap_it_allows() {
+    let e = fails(
+        "opt-memory",
+        &["--width", "16384", "--height", "16384", "--rsm", "64"],
+    );
+    let mib_after = |what: &str| -> u64 {
+        let rest = &e[e
+            .find(what)
+            .unwrap_or_else(|| panic!("no '{what}' in:\n{e}"))
+            + what.len()..];
+        let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        digits
+            .parse()
+            .unwrap_or_else(|_| panic!("no number after '{what}' in:\n{e}"))
+    };
+    let needed = mib_after("needs about ");
+    let allowed = mib_after("at most ");
+    let heap = mib_after("90% of the device's ");
+    assert!(
+        needed > allowed && allowed <= heap * 9 / 10 + 1 && allowed + 1 >= heap * 9 / 10,
+        "{e}"
+    );
+}

@@ -45,13 +45,39 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings, method_bytes: u64) -> Resul
         );
     }
     let needed = memory_estimate(s, method_bytes);
-    let heap = device_local_heap(gpu);
-    if heap > 0 && needed > heap / 10 * 9 {
-        bail!(
-            "resolution {}x{} with --rsm {r} needs about {} MiB of GPU memory; the device has {} MiB. Choose a smaller resolution",
+    within_memory_share(
+        &format!(
+            "resolution {}x{} with --rsm {r} needs about {} MiB of GPU memory",
             s.width,
             s.height,
-            needed >> 20,
+            needed >> 20
+        ),
+        needed,
+        device_local_heap(gpu),
+        "Choose a smaller resolution",
+    )
+}
+
+/// The share of the largest device-local heap a run may plan to use, in
+/// percent: the rest is left to the driver, the window system and other
+/// programs, and to what the estimates leave out.
+pub const MEMORY_SHARE_PERCENT: u64 = 90;
+
+/// The bytes of a `heap` a run may use ([`MEMORY_SHARE_PERCENT`]).
+pub fn usable_memory(heap: u64) -> u64 {
+    heap / 100 * MEMORY_SHARE_PERCENT
+}
+
+/// Refuses `needed` bytes if they pass the usable share of `heap` (0: not
+/// reported, nothing is refused), saying the rule and the numbers: `what`
+/// starts the message, `advice` ends it.
+fn within_memory_share(what: &str, needed: u64, heap: u64, advice: &str) -> Result<()> {
+    let usable = usable_memory(heap);
+    if heap > 0 && needed > usable {
+        bail!(
+            "{what}; isr plans to use at most {} MiB, {MEMORY_SHARE_PERCENT}% of the device's {} MiB \
+             heap. {advice}",
+            usable >> 20,
             heap >> 20
         );
     }
@@ -95,18 +121,24 @@ pub fn check_light_views(
         );
     }
     let extra = light_memory_estimate(s, views, instances, added.cube_rsm);
-    let needed = memory_estimate(s, added.method) + extra;
-    let heap = device_local_heap(gpu);
-    if heap > 0 && needed > heap / 10 * 9 {
-        bail!(
-            "the scene's {} lights ({views} RSMs) need about {} MiB of GPU memory besides the {} MiB of the run; the device has {} MiB. Remove lights or choose a smaller resolution",
-            lights.len(),
-            extra >> 20,
-            memory_estimate(s, added.method) >> 20,
-            heap >> 20
-        );
-    }
-    Ok(())
+    let run = memory_estimate(s, added.method);
+    within_memory_share(
+        &light_views_need(lights.len(), views, extra, run),
+        run + extra,
+        device_local_heap(gpu),
+        "Remove lights or choose a smaller resolution",
+    )
+}
+
+/// The start of [`check_light_views`]' refusal.
+fn light_views_need(lights: usize, views: usize, extra: u64, run: u64) -> String {
+    format!(
+        "the scene's {lights} lights ({views} RSMs) need about {} MiB of GPU memory besides the \
+         {} MiB of the run, {} MiB in all",
+        extra >> 20,
+        run >> 20,
+        (extra + run) >> 20
+    )
 }
 
 /// Bytes that lights add to `memory_estimate`. The views of a frame run one
@@ -169,7 +201,48 @@ pub fn check_ranges(s: &RenderSettings) -> Result<()> {
         bail!("--rsm {r}: the RSM resolution must be a power of two of at least 16 (it is the root of a quadtree)");
     }
     if !(s.exposure.is_finite() && s.exposure >= 0.0) {
-        bail!("--exposure must be a finite non-negative number");
+        bail!(
+            "--exposure {}: the exposure must be a finite non-negative number",
+            s.exposure
+        );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MIB: u64 = 1 << 20;
+
+    /// Issue 29, item 11: 1858 MiB of a 2048 MiB heap was refused with only
+    /// those two numbers; the message states the share that is allowed.
+    #[test]
+    fn a_memory_refusal_states_the_rule_and_agrees_with_it() {
+        let heap = 2048 * MIB;
+        assert_eq!(usable_memory(heap) >> 20, 1843);
+        let e = within_memory_share("it needs about 1858 MiB", 1858 * MIB, heap, "Choose less")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "it needs about 1858 MiB; isr plans to use at most 1843 MiB, 90% of the device's \
+             2048 MiB heap. Choose less"
+        );
+        within_memory_share("", usable_memory(heap), heap, "").unwrap();
+        within_memory_share("", u64::MAX, 0, "").unwrap();
+        let what = light_views_need(3, 8, 400 * MIB, 1500 * MIB);
+        assert_eq!(
+            what,
+            "the scene's 3 lights (8 RSMs) need about 400 MiB of GPU memory besides the 1500 MiB \
+             of the run, 1900 MiB in all"
+        );
+        let e = within_memory_share(&what, 1900 * MIB, heap, "Remove lights")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("1900 MiB in all; isr plans to use at most 1843 MiB, 90%"),
+            "{e}"
+        );
+    }
 }
