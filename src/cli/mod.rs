@@ -178,7 +178,7 @@ enum DebugView {
 
 /// Parses `std::env::args` and runs the command.
 pub fn run() -> Result<()> {
-    let cli = Cli::parse();
+    let cli = parse();
     interrupt::install()?;
     match cli.command {
         Command::Render(args) => render(*args),
@@ -197,6 +197,40 @@ pub fn run() -> Result<()> {
             println!("wrote {}", path.display());
             Ok(())
         }
+    }
+}
+
+/// The command line, with every numeric option of every command taking a
+/// value that starts with a minus sign (`--exposure -inf`, `--time -1e-5`,
+/// `--tau -.5`), which clap reads as options unless they are written as it
+/// writes negative numbers: the option's own check then judges the value.
+fn parse() -> Cli {
+    use clap::{CommandFactory as _, FromArgMatches as _};
+    let command = Cli::command().mut_subcommands(|c| c.mut_args(numeric_values_may_be_negative));
+    Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit())
+}
+
+/// `arg`, taking values that start with '-' if its values are numbers.
+fn numeric_values_may_be_negative(arg: clap::Arg) -> clap::Arg {
+    use std::any::TypeId;
+    let numeric = [
+        TypeId::of::<f32>(),
+        TypeId::of::<f64>(),
+        TypeId::of::<u8>(),
+        TypeId::of::<u16>(),
+        TypeId::of::<u32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<usize>(),
+        TypeId::of::<i32>(),
+        TypeId::of::<i64>(),
+        // The method parameters (`methods::args`).
+        TypeId::of::<crate::settings::Value>(),
+    ];
+    let id = arg.get_value_parser().type_id();
+    if numeric.iter().any(|t| id == *t) {
+        arg.allow_hyphen_values(true)
+    } else {
+        arg
     }
 }
 
