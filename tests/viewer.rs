@@ -210,6 +210,35 @@ fn viewer_without_a_display_says_how_to_get_one() {
         .env_remove("WAYLAND_DISPLAY")
         .fails();
     assert!(e.contains("xvfb") && e.contains("isr render"), "{e}");
+    // Issue 29, item 12b: what is wrong and what to do, not where in winit's
+    // source the error was raised.
+    assert!(
+        e.contains("DISPLAY") && e.contains("WAYLAND_DISPLAY"),
+        "the message does not say what is missing:\n{e}"
+    );
+    let no_source = |e: &str| {
+        assert!(
+            !e.contains(".cargo") && !e.contains("registry") && !e.contains(".rs:"),
+            "the message names a source file:\n{e}"
+        );
+    };
+    no_source(&e);
+    // A display that is set but cannot be reached, X11 and Wayland.
+    let e = Isr::new("view")
+        .env("DISPLAY", ":7391")
+        .env_remove("WAYLAND_DISPLAY")
+        .fails();
+    assert!(e.contains("DISPLAY :7391") && e.contains("xvfb"), "{e}");
+    no_source(&e);
+    let e = Isr::new("view")
+        .env_remove("DISPLAY")
+        .env("WAYLAND_DISPLAY", "isr-no-such-compositor")
+        .fails();
+    assert!(
+        e.contains("WAYLAND_DISPLAY isr-no-such-compositor") && e.contains("xvfb"),
+        "{e}"
+    );
+    no_source(&e);
 }
 
 #[test]

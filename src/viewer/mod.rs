@@ -54,9 +54,36 @@ pub fn interactive_methods() -> Vec<Method> {
 }
 
 /// Help for a machine without a window system.
-const NO_DISPLAY_HINT: &str = "isr view needs a window system: an X11 (DISPLAY) or Wayland \
+const NO_DISPLAY_HINT: &str = "isr view needs an X11 (DISPLAY) or Wayland \
      (WAYLAND_DISPLAY) session, or a virtual one such as `xvfb-run -a isr view` \
      (`sudo apt-get install xvfb`); `isr render` works headless";
+
+/// The error of a window system that cannot be reached (`doing`: what
+/// failed), saying what is wrong and what to do: winit's reason without the
+/// source location its `OsError` carries ("os error at FILE:LINE: REASON",
+/// a path in cargo's registry), the display variables as they are set, and
+/// [`NO_DISPLAY_HINT`].
+fn no_window_system(doing: &str, e: impl std::fmt::Display) -> anyhow::Error {
+    let text = e.to_string();
+    let reason = text
+        .strip_prefix("os error at ")
+        .and_then(|rest| rest.split_once(": "))
+        .map_or(text.as_str(), |(_, reason)| reason)
+        .trim_end_matches('.');
+    let set: Vec<String> = ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+        .iter()
+        .filter_map(|name| {
+            let value = std::env::var_os(name).filter(|v| !v.is_empty())?;
+            Some(format!("{name} {}", value.to_string_lossy()))
+        })
+        .collect();
+    let set = if set.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", set.join(", "))
+    };
+    anyhow!("{doing}: {reason}{set}. {NO_DISPLAY_HINT}")
+}
 
 /// The debug views `V` cycles through.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,10 +116,11 @@ impl Shown {
 /// Runs the viewer until the window closes, `Escape` or a script's `quit`.
 /// Fails when the validation layer (with `--validate`) reported anything.
 pub fn run(scene: &Scene, options: ViewOptions) -> Result<()> {
-    let event_loop = EventLoop::new().map_err(|e| anyhow!("{e}; {NO_DISPLAY_HINT}"))?;
+    let connect = "isr view cannot connect to a window system";
+    let event_loop = EventLoop::new().map_err(|e| no_window_system(connect, e))?;
     let display = event_loop
         .display_handle()
-        .map_err(|e| anyhow!("{e}; {NO_DISPLAY_HINT}"))?
+        .map_err(|e| no_window_system(connect, e))?
         .as_raw();
     let surface_extensions = ash_window::enumerate_required_extensions(display)
         .context("this window system has no Vulkan surface support")?;
@@ -263,7 +291,7 @@ impl<'g> Viewer<'g> {
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
-                .map_err(|e| anyhow!("creating the window: {e}; {NO_DISPLAY_HINT}"))?,
+                .map_err(|e| no_window_system("isr view cannot create its window", e))?,
         );
         let surface = Surface::new(
             gpu,
