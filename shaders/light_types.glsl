@@ -80,11 +80,12 @@ void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 inte
 }
 
 // Shadow lookup for receiver p (docs/algorithm.md section 2): how many metres
-// one RSM texel spans at p (for the normal offset), and the reference depth
-// for a receiver at RSM depth z tilted by tan_theta from the light. Perspective
-// reversed-Z depth is near/z, so biases are relative (d(near/z)/(near/z) =
-// -dz/z, the texel's angular size times the slope); orthographic depth is
-// linear over light_cone.w metres, so biases are lengths over that range.
+// one RSM texel spans at p, and the reference depth for a receiver at RSM
+// depth z, with `slope` already in NDC depth (direct_light.frag: the
+// receiver plane's gradient times the texels the compare spans). Perspective
+// reversed-Z depth is near/z, so the constant bias is relative
+// (d(near/z)/(near/z) = -dz/z); orthographic depth is linear, so it is an
+// offset of the depth range.
 float shadow_texel_world(vec3 p) {
     float res = float(run.rsm_resolution);
     if (light_is_directional()) return 2.0 * u.rsm_half_extent / res;
@@ -92,13 +93,9 @@ float shadow_texel_world(vec3 p) {
     return 2.0 * u.rsm_half_extent * max(dist, 0.0) / res;
 }
 
-float shadow_reference(float z, float tan_theta, float texel_world) {
-    float res = float(run.rsm_resolution);
-    if (light_is_directional()) {
-        return z + run.shadow_depth_bias + run.shadow_slope_bias * texel_world * tan_theta / u.rsm_depth_range;
-    }
-    float texel_angle = 2.0 * u.rsm_half_extent / res;
-    return z * (1.0 + run.shadow_depth_bias + run.shadow_slope_bias * texel_angle * tan_theta);
+float shadow_reference(float z, float slope) {
+    if (light_is_directional()) return z + run.shadow_depth_bias + slope;
+    return z * (1.0 + run.shadow_depth_bias) + slope;
 }
 
 // The length that ISR's relative depth threshold multiplies for a child at

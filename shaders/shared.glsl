@@ -44,10 +44,10 @@ const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 // that derives each value.
 struct RunUniforms {
     // Shadows of the direct light.
-    float shadow_normal_offset;   // RSM texels at the receiver
+    float shadow_normal_offset;   // RSM texels at the receiver (0 by default)
     float shadow_depth_bias;      // constant, relative to the distance to the light
     float pcf_radius;             // PCF tap spacing (RSM texels)
-    float shadow_slope_bias;      // RSM texels along the receiver's slope
+    float shadow_slope_bias;      // RSM texels of the receiver plane's depth gradient
     // Sizes.
     uvec2 output_size;            // width, height (pixels)
     uint rsm_resolution;          // R

@@ -40,13 +40,18 @@ pub struct RenderSettings {
     pub method: Method,
     /// Multiplier applied to radiance before the PNG's sRGB encoding.
     pub exposure: f32,
-    /// Shadow-map normal offset, in RSM texels at the receiver.
+    /// Shadow-map normal offset, in RSM texels at the receiver (0: every PCF
+    /// tap compares against the receiver's own plane instead, which does
+    /// not shift shadows sideways; kept for experiments).
     pub shadow_normal_offset: f32,
-    /// Constant relative depth bias of the shadow test (fraction of the distance).
+    /// Constant depth bias of the shadow test: relative to the distance for
+    /// perspective RSMs, a fraction of the depth range for orthographic ones.
     pub shadow_depth_bias: f32,
     /// PCF tap spacing in RSM texels.
     pub pcf_radius: f32,
-    /// Slope-scaled shadow bias, in RSM texels along the receiver's slope.
+    /// Receiver-plane bias: how many RSM texels of the receiver plane's
+    /// depth gradient the hardware 2x2 compare may span (its texels lie up
+    /// to one texel from the tap: 1).
     pub shadow_slope_bias: f32,
     /// The parameters set to other than their defaults (`Param::get` reads
     /// them, `Param::set` writes them).
@@ -61,10 +66,10 @@ impl RenderSettings {
         rsm_resolution: 512,
         method: Method::new("multires-gather"),
         exposure: 1.0,
-        shadow_normal_offset: 1.5,
+        shadow_normal_offset: 0.0,
         shadow_depth_bias: 5e-4,
         pcf_radius: 1.0,
-        shadow_slope_bias: 2.5,
+        shadow_slope_bias: 1.0,
         params: Params::new(),
     };
 
