@@ -18,7 +18,7 @@ layout(set = 1, binding = 2, std430) readonly buffer LpvSum { vec4 sum[]; };
 layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2)
 
 // Cells over which a cascade hands over to the next coarser one.
-const int BLEND = LPV_SIZE >= 16 ? LPV_SIZE / 8 : 1;
+const int BLEND = LPV_SIZE >= 8 ? LPV_SIZE / 8 : 1;  // Layout::blend_cells
 
 // Irradiance at p (normal n) from cascade c, at cell-centre coordinates g.
 vec3 cascade_irradiance(int c, vec3 g, vec3 n) {

@@ -97,6 +97,7 @@ every_method! {
     multires_gather_fails_at_every_pipeline: "multires-gather",
     isr_fails_at_every_pipeline: "isr",
     hisr_fails_at_every_pipeline: "hisr",
+    lpv_fails_at_every_pipeline: "lpv",
     reference_fails_at_every_pipeline: "reference",
 }
 

@@ -139,4 +139,39 @@ impl Grid {
         let dot = |s: [f64; 4]| (0..4).map(|k| s[k] * lobe[k]).sum::<f64>().max(0.0) / (h * h);
         DVec3::new(dot(sh[0]), dot(sh[1]), dot(sh[2]))
     }
+
+    /// How much of a point's irradiance cascade `c` at `at` gives (before the
+    /// finer cascades take their share), as `lpv_lookup.frag` weighs it: 1
+    /// inside, falling to 0 over the outer `blend_cells()` cell centres; the
+    /// coarsest takes all of what is left within half a cell of its last
+    /// centres.
+    pub fn weight(&self, c: u32, at: &Cascade, p: DVec3, n: DVec3) -> f64 {
+        let size = self.layout.size as f64;
+        let g = at.grid_position(p + 0.5 * at.cell as f64 * n) - DVec3::splat(0.5);
+        let inner = g.min(DVec3::splat(size - 1.0) - g).min_element();
+        if c + 1 == self.layout.cascades {
+            (inner >= -0.5) as u8 as f64
+        } else {
+            (inner / self.layout.blend_cells() as f64).clamp(0.0, 1.0)
+        }
+    }
+
+    /// The irradiance `lpv_lookup.frag` writes for a point `p` with unit
+    /// normal `n`: the finest cascade that holds it, blended into the next
+    /// coarser one near its border.
+    pub fn lookup(&self, cascades: &[Cascade], p: DVec3, n: DVec3) -> DVec3 {
+        let mut e = DVec3::ZERO;
+        let mut remaining = 1.0;
+        for (c, at) in cascades.iter().enumerate() {
+            if remaining <= 0.0 {
+                break;
+            }
+            let w = self.weight(c as u32, at, p, n);
+            if w > 0.0 {
+                e += remaining * w * self.irradiance(c as u32, at, p, n);
+                remaining *= 1.0 - w;
+            }
+        }
+        e
+    }
 }

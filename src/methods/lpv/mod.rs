@@ -91,6 +91,13 @@ impl Layout {
         }
     }
 
+    /// Cells over which the lookup hands a cascade over to the next coarser
+    /// one near its border (`BLEND` in `shaders/lpv_lookup.frag`): an eighth
+    /// of the side, at least 1.
+    pub fn blend_cells(&self) -> u32 {
+        (self.size / 8).max(1)
+    }
+
     /// Cells of all cascades.
     pub fn cells(&self) -> u64 {
         (self.size as u64).pow(3) * self.cascades as u64
