@@ -131,7 +131,7 @@ impl Descriptor for LpvMethod {
         KEY
     }
     fn color(&self) -> [u8; 3] {
-        [31, 119, 180]
+        [23, 190, 207]
     }
     fn help(&self) -> &'static str {
         "Cascaded light propagation volumes: VPLs in SH grids, propagated to neighbours."
