@@ -34,6 +34,9 @@ static ALLOC: Counting = Counting;
 /// Tight budgets so that what they allow is small and anything else stands out.
 const FUZZ_LIMITS: Limits = Limits {
     scene_file_bytes: 8 << 20,
+    line_bytes: 1 << 20,
+    material_library_bytes: 1 << 20,
+    description_bytes: 1 << 16,
     buffer_bytes: 8 << 20,
     image_file_bytes: 1 << 20,
     texture_dimension: 1024,

@@ -20,6 +20,9 @@ fuzz_target!(|data: &[u8]| {
         allow_outside_uris: false,
         limits: Limits {
             scene_file_bytes: 8 << 20,
+            line_bytes: 1 << 20,
+            material_library_bytes: 1 << 20,
+            description_bytes: 1 << 16,
             buffer_bytes: 8 << 20,
             image_file_bytes: 1 << 20,
             texture_dimension: 1024,

@@ -8,8 +8,17 @@
 /// uses; tests (the fuzzer) pass tighter ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Limits {
-    /// Bytes of the `.gltf`/`.glb` file itself.
+    /// Bytes of the `.gltf`/`.glb`/`.obj` file itself (an OBJ is checked
+    /// before it is read, then read line by line, never whole).
     pub scene_file_bytes: u64,
+    /// Bytes of one line of an OBJ or MTL file (a line is held whole while
+    /// it is parsed; a face of 10^6 vertices is about 7 MB).
+    pub line_bytes: u64,
+    /// Bytes of all MTL material libraries of an OBJ together, each checked
+    /// before it is read.
+    pub material_library_bytes: u64,
+    /// Bytes of a scene description (`NAME.scene.json`).
+    pub description_bytes: u64,
     /// Bytes of all buffers together (their declared `byteLength`s), checked
     /// before any buffer is read.
     pub buffer_bytes: u64,
@@ -25,10 +34,13 @@ pub struct Limits {
     pub node_visits: u64,
     /// Nesting depth of the node hierarchy.
     pub hierarchy_depth: u64,
-    /// Triangles of all mesh instances together.
+    /// Triangles of all mesh instances together (an OBJ's polygons counted
+    /// as the triangles they fan into, as each face is read).
     pub triangles: u64,
     /// Vertices of all mesh instances together (bounds every per-vertex array,
-    /// including sparse accessors, which need no data to declare a count).
+    /// including sparse accessors, which need no data to declare a count;
+    /// in an OBJ, each of the `v`, `vt` and `vn` lists as it is read, and the
+    /// distinct vertices its faces make).
     pub vertices: u64,
     /// Largest world-space coordinate, in metres. The renderer works in f32:
     /// beyond about 1e19 the shaders' squared distances overflow (NaN normals
@@ -46,6 +58,9 @@ pub struct Limits {
 impl Limits {
     pub const DEFAULT: Limits = Limits {
         scene_file_bytes: 2 << 30,
+        line_bytes: 64 << 20,
+        material_library_bytes: 64 << 20,
+        description_bytes: 1 << 20,
         buffer_bytes: 2 << 30,
         image_file_bytes: 256 << 20,
         texture_dimension: 16384,

@@ -1,15 +1,58 @@
 //! Scenes: triangle meshes placed by transforms, diffuse materials, a list
-//! of lights (spot, point, directional) and one perspective camera. Loaded from glTF (`gltf_load`), built in
-//! (`cornell`), or assembled by code (tests) with the helpers below.
+//! of lights (spot, point, directional) and one perspective camera. Loaded from glTF (`gltf_load`),
+//! Wavefront OBJ (`obj_load`) or a scene description naming either
+//! (`description`), all through [`load_file`]; built in (`cornell`), or
+//! assembled by code (tests) with the helpers below.
 
 mod accessor;
 pub mod animation;
 pub mod cornell;
+pub mod description;
 pub mod export;
 pub mod gltf_load;
 pub mod limits;
 pub mod motion;
+pub mod obj_load;
+pub mod one_texture;
 mod uri;
+
+pub use gltf_load::LoadOptions;
+
+/// What kind of scene file a path names, by its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// `.obj`: Wavefront OBJ (+ MTL).
+    Obj,
+    /// `.json` (`NAME.scene.json`): a scene description naming a mesh.
+    Description,
+    /// `.gltf`, `.glb` and anything else: glTF (the loader reads the GLB
+    /// magic or the JSON and says what is wrong with other files).
+    Gltf,
+}
+
+impl FileKind {
+    pub fn of(path: &std::path::Path) -> FileKind {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("obj") => FileKind::Obj,
+            Some("json") => FileKind::Description,
+            _ => FileKind::Gltf,
+        }
+    }
+}
+
+/// Loads the scene file `path` with the loader its extension names
+/// ([`FileKind`]): glTF, OBJ or a scene description, each under the same
+/// policy and budgets (`options`; docs/security.md).
+pub fn load_file(path: &std::path::Path, options: &LoadOptions) -> anyhow::Result<Scene> {
+    match FileKind::of(path) {
+        FileKind::Obj => obj_load::load_with(path, options),
+        FileKind::Description => description::load_with(path, options),
+        FileKind::Gltf => gltf_load::load_with(path, options),
+    }
+}
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
