@@ -47,13 +47,33 @@ fn method_parser() -> impl clap::builder::TypedValueParser<Value = MethodArg> {
 
 #[derive(Args, Clone)]
 pub struct RunArgs {
-    /// glTF 2.0 scene (.gltf or .glb); the built-in Cornell box when omitted.
+    /// The scene: glTF 2.0 (.gltf, .glb), Wavefront OBJ (.obj, with its MTL
+    /// and textures) or a scene description naming either with lights,
+    /// camera and motion (NAME.scene.json; README, "Scenes from the
+    /// archives"); the built-in Cornell box when omitted.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Let the scene's buffer and image URIs name files outside its folder
-    /// (absolute paths, '..', file: URIs, symbolic links out of it).
+    /// Let the scene's files (buffers, images, an OBJ's MTL and textures, a
+    /// description's mesh) be outside its folder (absolute paths, '..',
+    /// file: URIs, symbolic links out of it).
     #[arg(long)]
     pub allow_outside_uris: bool,
+    /// A light instead of the scene's (repeat for several):
+    /// `spot:position=X,Y,Z:target=X,Y,Z[:cone=DEG][:inner=DEG][:intensity=CD][:color=R,G,B][:range=M]`,
+    /// `point:position=X,Y,Z[:intensity=CD]...` or
+    /// `directional:direction=X,Y,Z[:intensity=LUX]...`, in metres with +Y
+    /// up. Intensity defaults to what makes a white surface at the target
+    /// (or the scene's centre) facing the light reflect radiance 1; the cone
+    /// (outer half-angle) to 45 degrees, the inner to 3/4 of it. Move it with
+    /// --orbit-light, or give it a path in a scene description.
+    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_light)]
+    pub light: Vec<crate::scene::description::LightSpec>,
+    /// The camera instead of the scene's:
+    /// `position=X,Y,Z[:target=X,Y,Z][:fov=DEG][:znear=M]` (target default:
+    /// the scene's centre; fov vertical, default 45; znear default 1/1000 of
+    /// the scene's diagonal). Move it with --orbit-camera.
+    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_camera)]
+    pub camera: Option<crate::scene::description::CameraSpec>,
     /// How indirect light is computed.
     #[arg(long, value_parser = method_parser(), default_value = D.method.name())]
     pub method: MethodArg,
@@ -103,18 +123,35 @@ impl RunArgs {
         s
     }
 
-    /// The scene: `--scene`'s file, or the built-in Cornell box.
+    /// The scene: `--scene`'s file (glTF, OBJ or a description, by its
+    /// extension), or the built-in Cornell box; with `--light` and
+    /// `--camera` in place of its own.
     pub fn load_scene(&self) -> Result<crate::scene::Scene> {
-        let scene = match &self.scene {
-            Some(path) => crate::scene::gltf_load::load_with(
+        let mut scene = match &self.scene {
+            Some(path) => crate::scene::load_file(
                 path,
-                &crate::scene::gltf_load::LoadOptions {
+                &crate::scene::LoadOptions {
                     allow_outside_uris: self.allow_outside_uris,
                     ..Default::default()
                 },
             )?,
             None => crate::scene::cornell::cornell_box(),
         };
+        if !self.light.is_empty() || self.camera.is_some() {
+            let lights: Vec<(String, crate::scene::description::LightSpec)> = self
+                .light
+                .iter()
+                .enumerate()
+                .map(|(i, l)| (format!("--light {}", i + 1), l.clone()))
+                .collect();
+            crate::scene::description::apply(&mut scene, &lights, self.camera.as_ref())?;
+            // What the file's warnings said of its default light or camera
+            // no longer holds.
+            scene.warnings.retain(|w| {
+                !((!lights.is_empty() && w.contains("default spot light"))
+                    || (self.camera.is_some() && w.contains("default camera")))
+            });
+        }
         for w in &scene.warnings {
             eprintln!("warning: {w}");
         }
