@@ -104,11 +104,18 @@ pub struct SceneSpec {
 }
 
 impl SceneSpec {
-    fn load(&self) -> Result<Scene> {
-        match &self.file {
-            Some(p) => crate::scene::gltf_load::load_with(p, &Default::default()),
-            None => scenes::build(&self.name),
+    /// The scene, fitted to what `gpu` can sample (`scene::one_texture`).
+    fn load(&self, gpu: &Gpu) -> Result<Scene> {
+        let mut scene = match &self.file {
+            Some(p) => crate::scene::load_file(p, &Default::default())?,
+            None => scenes::build(&self.name)?,
+        };
+        if !gpu.features.sampled_image_array_indexing {
+            if let Some(w) = crate::scene::one_texture::keep_one(&mut scene) {
+                eprintln!("warning: {}: {w}", self.name);
+            }
         }
+        Ok(scene)
     }
 }
 
@@ -373,7 +380,7 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     }
     let bar = crate::progress::bar(units, "frames");
     for (spec, work) in &pending {
-        let scene = spec.load()?;
+        let scene = spec.load(&gpu)?;
         run_scene(plan, &gpu, spec, &scene, work, &journal, &bar)?;
     }
     bar.finish_and_clear();
