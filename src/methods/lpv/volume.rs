@@ -76,8 +76,9 @@ impl Lpv {
                 gpu.info.name
             );
         }
-        require_blending(gpu, SH_FORMAT, "lpv")?;
-        require_blending(gpu, GEOMETRY_FORMAT, "lpv")?;
+        for format in [SH_FORMAT, GEOMETRY_FORMAT] {
+            require_blending(gpu, format, "lpv")?;
+        }
         let (n, c) = (layout.size, layout.cascades);
         let image = |name: &str, format| {
             Image::new(
