@@ -137,10 +137,15 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
     let rows = json["rows"].as_array().unwrap();
-    // Two scenes, each: the reference and 17 sweep points of 8 methods (two
-    // VPL counts for each of five regular methods, two ISR bases, two taus,
-    // three LPV points).
-    assert_eq!(rows.len(), 2 * 18);
+    // Two scenes, each: the reference and every swept method's quick sweep
+    // at the quick bench's RSM of 64 (from the registry: a new method
+    // changes the count without a line here).
+    let points: usize = isr::bench::sweep::methods()
+        .into_iter()
+        .map(|m| isr::bench::sweep::sweep(m, 64, true).len())
+        .sum();
+    assert!(points >= 15, "{points} sweep points");
+    assert_eq!(rows.len(), 2 * (1 + points));
     let mut all = vec![];
     numbers(&json, &mut all);
     assert!(all.iter().all(|v| v.is_finite()));

@@ -244,18 +244,12 @@ fn timings_json_from_the_cli_lists_every_pass() {
 fn validation_with_synchronization_checks_is_silent_over_several_frames() {
     let gpu = validating_gpu();
     assert!(gpu.validating());
-    for (method, stencil) in [
-        (Method::new("none"), true),
-        (Method::new("multires-gather"), true),
-        (Method::new("multires-gather"), false),
-        (Method::new("isr"), true),
-        (Method::new("hisr"), true),
-        (Method::new("rsm-gather"), true),
-        (Method::new("rsm-splat"), true),
-        (Method::new("rsm-splat-restricted"), true),
-        (Method::new("multires-splat"), true),
-        (Method::new("reference"), true),
-    ] {
+    // Every registered method, and the stenciled gather without its stencil.
+    let runs = isr::methods::REGISTRY
+        .iter()
+        .map(|d| (d.key(), true))
+        .chain([(Method::new("multires-gather"), false)]);
+    for (method, stencil) in runs {
         let settings = RenderSettings {
             method,
             ..sized("none", 160, 120, 128)
