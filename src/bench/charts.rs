@@ -143,6 +143,13 @@ where
         .map_err(|e| anyhow!("{e}"))?;
     let (r, c) = grid(scenes.len());
     let panels = root.split_evenly((r, c));
+    // One legend for every panel in a cell the grid leaves free; without
+    // one, each panel's own, in its corner with the fewest points under it.
+    let all_methods = methods_in(rows);
+    let free = panels.get(scenes.len());
+    if let Some(cell) = free {
+        legend_panel(cell, &all_methods)?;
+    }
     for (scene, panel) in scenes.iter().zip(panels.iter()) {
         let pts: Vec<&Row> = rows
             .iter()
@@ -158,7 +165,7 @@ where
             .margin(8)
             .x_label_area_size(36)
             .y_label_area_size(56)
-            .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+            .build_cartesian_2d(xr.clone().log_scale(), yr.clone().log_scale())
             .map_err(|e| anyhow!("{e}"))?;
         chart
             .configure_mesh()
@@ -177,6 +184,11 @@ where
                 methods.push(&p.method);
             }
         }
+        let points: Vec<(f64, f64)> = pts
+            .iter()
+            .filter_map(|p| Some((p.indirect_ms?, y(p)?)))
+            .collect();
+        let corner = emptiest_corner(&points, (&xr, &yr), methods.len());
         for m in methods {
             let color = method_color(m);
             let mut line: Vec<(f64, f64)> = pts
@@ -196,15 +208,88 @@ where
                 .draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(|e| anyhow!("{e}"))?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+        if free.is_none() {
+            chart
+                .configure_series_labels()
+                .position(corner)
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 11))
+                .draw()
+                .map_err(|e| anyhow!("{e}"))?;
+        }
     }
     Ok(())
+}
+
+/// Every method of `rows` but the reference, in first appearance.
+fn methods_in(rows: &[Row]) -> Vec<&str> {
+    let mut out: Vec<&str> = vec![];
+    for r in rows {
+        if r.method != "reference" && !out.contains(&r.method.as_str()) {
+            out.push(&r.method);
+        }
+    }
+    out
+}
+
+/// The legend of `methods`, drawn alone in a free cell of the grid.
+fn legend_panel<DB: DrawingBackend>(cell: &DrawingArea<DB, Shift>, methods: &[&str]) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let (w, h) = cell.dim_in_pixel();
+    let (x0, y0) = (w as i32 / 4, (h as i32 - 22 * methods.len() as i32) / 2);
+    for (i, m) in methods.iter().enumerate() {
+        let y = y0 + 22 * i as i32;
+        let color = method_color(m);
+        cell.draw(&PathElement::new(
+            vec![(x0, y), (x0 + 28, y)],
+            color.stroke_width(3),
+        ))
+        .map_err(|e| anyhow!("{e}"))?;
+        cell.draw(&Circle::new((x0 + 14, y), 3, color.filled()))
+            .map_err(|e| anyhow!("{e}"))?;
+        cell.draw(&Text::new(
+            m.to_string(),
+            (x0 + 38, y - 8),
+            ("sans-serif", 15).into_font(),
+        ))
+        .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
+}
+
+/// Of a log-log panel's four corners, the one whose legend box (about a third
+/// of the width, a line per method) covers the fewest of `points`.
+fn emptiest_corner(
+    points: &[(f64, f64)],
+    (xr, yr): (&std::ops::Range<f64>, &std::ops::Range<f64>),
+    methods: usize,
+) -> SeriesLabelPosition {
+    let unit =
+        |v: f64, r: &std::ops::Range<f64>| (v.ln() - r.start.ln()) / (r.end.ln() - r.start.ln());
+    let (bw, bh) = (0.36, (0.05 * methods as f64 + 0.04).min(0.9));
+    let corners = [
+        (SeriesLabelPosition::UpperRight, 1.0 - bw, 1.0 - bh),
+        (SeriesLabelPosition::LowerLeft, 0.0, 0.0),
+        (SeriesLabelPosition::UpperLeft, 0.0, 1.0 - bh),
+        (SeriesLabelPosition::LowerRight, 1.0 - bw, 0.0),
+    ];
+    let covered = |&(_, x, y): &(SeriesLabelPosition, f64, f64)| {
+        points
+            .iter()
+            .filter(|&&(px, py)| {
+                let (u, v) = (unit(px, xr), unit(py, yr));
+                u >= x - 0.02 && u <= x + bw + 0.02 && v >= y - 0.02 && v <= y + bh + 0.02
+            })
+            .count()
+    };
+    let best = corners
+        .iter()
+        .min_by_key(|c| covered(c))
+        .expect("four corners");
+    best.0.clone()
 }
 
 /// `speed_vs_error.svg/.png`: indirect ms against relative RMSE of the
