@@ -26,7 +26,8 @@ use sweep::Config;
 #[derive(clap::Args, Clone, Debug)]
 pub struct BenchArgs {
     /// Scenes (comma-separated): bench scene names (see `scenes::SCENES`) or
-    /// paths to .gltf/.glb files. Default: all bench scenes (quick: cornell, slats).
+    /// paths to .gltf/.glb/.obj files or scene descriptions (.scene.json).
+    /// Default: all bench scenes (quick: cornell, slats).
     #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub scenes: Vec<String>,
     /// Methods to sweep (comma-separated). Default: every method with a sweep
@@ -94,13 +95,18 @@ pub struct Plan {
     pub device: Option<usize>,
 }
 
-/// A scene of the run: its name, how it is made and its animation window.
+/// A scene of the run: its name, how it is made, its animation window, and
+/// the size (width = height = RSM) and frames it is benched at where they
+/// are not the run's (the archive scenes', unless the command line sets
+/// them).
 #[derive(Clone, Debug)]
 pub struct SceneSpec {
     pub name: String,
     pub file: Option<PathBuf>,
     pub start: f32,
     pub fps: f32,
+    pub size: Option<u32>,
+    pub frames: Option<u32>,
 }
 
 impl SceneSpec {
@@ -132,12 +138,21 @@ impl BenchArgs {
             };
             d.iter().map(|s| s.to_string()).collect()
         } else {
-            self.scenes.clone()
+            self.scenes
+                .iter()
+                .flat_map(|n| match scenes::group(n) {
+                    Some(g) => g.into_iter().map(str::to_string).collect(),
+                    None => vec![n.clone()],
+                })
+                .collect()
         };
         let mut specs = vec![];
         for n in names {
             let lower = n.to_ascii_lowercase();
-            if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            if [".gltf", ".glb", ".obj", ".json"]
+                .iter()
+                .any(|e| lower.ends_with(e))
+            {
                 let path = PathBuf::from(&n);
                 if !path.is_file() {
                     bail!("scene file {n} does not exist");
@@ -151,14 +166,20 @@ impl BenchArgs {
                     file: Some(path),
                     start: 0.0,
                     fps: 10.0,
+                    size: None,
+                    frames: None,
                 });
             } else {
                 let s = scenes::find(&n)?;
+                // A scene's own size and frames yield to the command line's.
+                let sized = self.width.is_none() && self.height.is_none() && self.rsm.is_none();
                 specs.push(SceneSpec {
                     name: s.name.into(),
                     file: None,
                     start: s.start,
                     fps: s.fps,
+                    size: s.size.filter(|_| sized && !q),
+                    frames: s.frames.filter(|_| self.frames.is_none() && !q),
                 });
             }
         }
@@ -214,6 +235,16 @@ impl BenchArgs {
 }
 
 impl Plan {
+    /// The plan of scene `s`: the run's, at the scene's own size and frames.
+    pub fn for_scene(&self, s: &SceneSpec) -> Plan {
+        let mut p = self.clone();
+        if let Some(n) = s.size {
+            (p.base.width, p.base.height, p.base.rsm_resolution) = (n, n, n);
+        }
+        p.frames = s.frames.unwrap_or(p.frames);
+        p
+    }
+
     /// The sweep points of every method.
     pub fn configs(&self) -> Vec<Config> {
         self.methods
@@ -235,9 +266,10 @@ impl Plan {
     pub fn keys(&self) -> Vec<String> {
         let mut keys = vec![];
         for s in &self.scenes {
-            keys.push(self.key(&s.name, REFERENCE.name(), REFERENCE_LABEL));
-            for c in self.configs() {
-                keys.push(self.key(&s.name, c.method.name(), &c.label(&self.base)));
+            let p = self.for_scene(s);
+            keys.push(p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL));
+            for c in p.configs() {
+                keys.push(p.key(&s.name, c.method.name(), &c.label(&p.base)));
             }
         }
         keys
@@ -313,7 +345,7 @@ fn check_outputs(plan: &Plan) -> Result<()> {
         .map(|n| dir.join(n))
         .collect();
     for s in &plan.scenes {
-        files.extend(gallery_images(plan, s));
+        files.extend(gallery_images(&plan.for_scene(s), s));
     }
     for f in files {
         crate::output::check_output("bench output", &f, Some(&remedy))?;
@@ -340,11 +372,13 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     })?;
     crate::bench::charts::register_font();
     // Work units: one per frame rendered (reference and every pending point).
-    let configs = plan.configs();
     let mut pending: Vec<(SceneSpec, Pending)> = vec![];
     let mut units = 0u64;
-    let image_frames = plan.frames / 2 + 1;
-    for s in &plan.scenes {
+    let run_plan = plan;
+    for s in &run_plan.scenes {
+        let plan = &run_plan.for_scene(s);
+        let configs = plan.configs();
+        let image_frames = plan.frames / 2 + 1;
         let is_done =
             |c: &Config| done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base)));
         let todo: Vec<Config> = configs.iter().filter(|c| !is_done(c)).cloned().collect();
@@ -381,7 +415,7 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     let bar = crate::progress::bar(units, "frames");
     for (spec, work) in &pending {
         let scene = spec.load(&gpu)?;
-        run_scene(plan, &gpu, spec, &scene, work, &journal, &bar)?;
+        run_scene(&plan.for_scene(spec), &gpu, spec, &scene, work, &journal, &bar)?;
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;

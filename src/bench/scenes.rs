@@ -1,8 +1,13 @@
-//! The stress scenes of `isr bench`, built by code and written to
-//! `assets/NAME.gltf` by `cargo run --release --example stress_scenes` (our
-//! own geometry, licensed with the repository). Each is as small as it can be
-//! while making its point, and each has an animation (the light moves; in
-//! `hall` the camera moves too; in `moving-block` an object moves).
+//! The scenes of `isr bench`. The stress scenes ([`SCENES`]), built by code
+//! and written to `assets/NAME.gltf` by `cargo run --release --example
+//! stress_scenes` (our own geometry, licensed with the repository): each is
+//! as small as it can be while making its point, and each has an animation
+//! (the light moves; in `hall` the camera moves too; in `moving-block` an
+//! object moves). And the archive scenes ([`ARCHIVE`]): the OBJ scenes
+//! researchers know, read from the archive folder (`ISR_SCENES`, or
+//! `../shared/scenes` beside the repository; never copied into it), lit,
+//! framed and moved by the scene descriptions `assets/archive/NAME.scene.json`
+//! (compiled in, and loadable as they are with `--scene`).
 //!
 //! | name | point |
 //! | --- | --- |
@@ -11,6 +16,10 @@
 //! | `hall` | 40 m hall of pillars, light far from most geometry: where HISR's distance-based refinement should pay; camera path |
 //! | `slats` | light grazing a ribbed wall through thin blinds, moving across them: regular VPLs jump between surfaces |
 //! | `moving-block` | a still light and a coloured block sliding through its spot |
+//! | `sibenik` | the cathedral (73,564 triangles), a spot moving along the nave |
+//! | `sponza` | the Dabrovic atrium (66,445), a low sun through the open roof, sweeping |
+//! | `conference` | the conference room (331,179, 53,627 degenerate), a spot moving over the table |
+//! | `bunny` | the Stanford bunny (69,451) on a floor in a room, the light circling it |
 
 use crate::scene::animation::{
     rotation_looking_along, Animation, Channel, Interpolation, Local, Parent, Property, Trs,
@@ -26,7 +35,21 @@ pub struct BenchScene {
     pub about: &'static str,
     pub start: f32,
     pub fps: f32,
+    /// An archive scene's description (`assets/archive/NAME.scene.json`);
+    /// `None` for a scene built by code.
+    pub description: Option<&'static str>,
+    /// The image size and RSM resolution (width = height = RSM) the scene
+    /// is benched at where the command line sets none; `None`: the run's.
+    pub size: Option<u32>,
+    /// Its animation frames where the command line sets none.
+    pub frames: Option<u32>,
 }
+
+/// The archive scenes at 64x64 (RSM 64) and 3 frames: at the stress scenes'
+/// 128x128 and 6 frames a full sweep of Sibenik alone took 103 s here (the
+/// five stress scenes take about 4 minutes); at 64x64, 23 s.
+const ARCHIVE_SIZE: Option<u32> = Some(64);
+const ARCHIVE_FRAMES: Option<u32> = Some(3);
 
 /// Every bench scene, in the order reports list them.
 pub const SCENES: &[BenchScene] = &[
@@ -35,47 +58,131 @@ pub const SCENES: &[BenchScene] = &[
         about: "Cornell box, light sweeping toward the green wall",
         start: 0.0,
         fps: 10.0,
+        description: None,
+        size: None,
+        frames: None,
     },
     BenchScene {
         name: "fine",
         about: "stairs, columns and a slatted screen",
         start: 0.0,
         fps: 10.0,
+        description: None,
+        size: None,
+        frames: None,
     },
     BenchScene {
         name: "hall",
         about: "40 m hall of pillars, light 14 m up, camera dollying",
         start: 0.0,
         fps: 10.0,
+        description: None,
+        size: None,
+        frames: None,
     },
     BenchScene {
         name: "slats",
         about: "grazing light moving across a ribbed wall behind thin blinds",
         start: 0.0,
         fps: 10.0,
+        description: None,
+        size: None,
+        frames: None,
     },
     BenchScene {
         name: "moving-block",
         about: "a red block sliding through a still spot",
         start: 0.0,
         fps: 10.0,
+        description: None,
+        size: None,
+        frames: None,
     },
 ];
 
-/// The bench scene called `name`, or an error listing the valid names.
-pub fn find(name: &str) -> anyhow::Result<&'static BenchScene> {
-    SCENES.iter().find(|s| s.name == name).ok_or_else(|| {
-        let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
-        anyhow::anyhow!(
-            "unknown scene '{name}'; the bench scenes are: {}",
-            names.join(", ")
-        )
-    })
+/// The archive scenes (`isr bench --scenes archive`), in report order.
+pub const ARCHIVE: &[BenchScene] = &[
+    BenchScene {
+        name: "sibenik",
+        about: "Sibenik cathedral, a spot moving along the nave",
+        start: 0.0,
+        fps: 10.0,
+        description: Some(include_str!("../../assets/archive/sibenik.scene.json")),
+        size: ARCHIVE_SIZE,
+        frames: ARCHIVE_FRAMES,
+    },
+    BenchScene {
+        name: "sponza",
+        about: "Dabrovic Sponza, a low sun through the open roof, sweeping",
+        start: 0.0,
+        fps: 10.0,
+        description: Some(include_str!("../../assets/archive/sponza.scene.json")),
+        size: ARCHIVE_SIZE,
+        frames: ARCHIVE_FRAMES,
+    },
+    BenchScene {
+        name: "conference",
+        about: "the conference room, a spot moving over the table",
+        start: 0.0,
+        fps: 10.0,
+        description: Some(include_str!("../../assets/archive/conference.scene.json")),
+        size: ARCHIVE_SIZE,
+        frames: ARCHIVE_FRAMES,
+    },
+    BenchScene {
+        name: "bunny",
+        about: "the Stanford bunny on a floor in a room, the light circling it",
+        start: 0.0,
+        fps: 10.0,
+        description: Some(include_str!("../../assets/archive/bunny.scene.json")),
+        size: ARCHIVE_SIZE,
+        frames: ARCHIVE_FRAMES,
+    },
+];
+
+/// Names `--scenes` takes for several scenes: `stress` (the default),
+/// `archive` and `all`.
+pub fn group(name: &str) -> Option<Vec<&'static str>> {
+    let names = |list: &[BenchScene]| list.iter().map(|s| s.name).collect::<Vec<_>>();
+    match name {
+        "stress" => Some(names(SCENES)),
+        "archive" => Some(names(ARCHIVE)),
+        "all" => Some(names(SCENES).into_iter().chain(names(ARCHIVE)).collect()),
+        _ => None,
+    }
 }
 
-/// Builds the scene by name (`cornell` is the built-in box).
+/// The bench scene called `name`, or an error listing the valid names.
+pub fn find(name: &str) -> anyhow::Result<&'static BenchScene> {
+    SCENES
+        .iter()
+        .chain(ARCHIVE)
+        .find(|s| s.name == name)
+        .ok_or_else(|| {
+            let names: Vec<&str> = SCENES.iter().chain(ARCHIVE).map(|s| s.name).collect();
+            anyhow::anyhow!(
+                "unknown scene '{name}'; the bench scenes are: {} (and the groups stress, archive, all)",
+                names.join(", ")
+            )
+        })
+}
+
+/// An archive scene, from its description (its mesh from the archive
+/// folder); the error says how to get the archive when it is missing.
+fn archive(s: &BenchScene, description: &str) -> anyhow::Result<Scene> {
+    let path = std::path::PathBuf::from(format!("assets/archive/{}.scene.json", s.name));
+    crate::scene::description::load_bytes(&path, description.as_bytes(), &Default::default())
+        .map_err(|e| e.context(format!("bench scene {}", s.name)))
+}
+
+/// Builds the scene by name (`cornell` is the built-in box; the archive
+/// scenes are loaded).
 pub fn build(name: &str) -> anyhow::Result<Scene> {
-    Ok(match find(name)?.name {
+    let s = find(name)?;
+    if let Some(d) = s.description {
+        return archive(s, d);
+    }
+    Ok(match s.name {
         "cornell" => cornell::cornell_box(),
         "fine" => fine(),
         "hall" => hall(),
