@@ -415,7 +415,15 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     let bar = crate::progress::bar(units, "frames");
     for (spec, work) in &pending {
         let scene = spec.load(&gpu)?;
-        run_scene(&plan.for_scene(spec), &gpu, spec, &scene, work, &journal, &bar)?;
+        run_scene(
+            &plan.for_scene(spec),
+            &gpu,
+            spec,
+            &scene,
+            work,
+            &journal,
+            &bar,
+        )?;
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;
