@@ -58,9 +58,8 @@ impl<'a, R: BufRead> Checked<'a, R> {
             };
             let keep = if done { take - 1 } else { take };
             if (self.raw.len() + keep) as u64 > max {
-                let line = self.state.borrow().line + 1;
                 bail!(
-                    "line {line} is longer than {}, the limit for one line",
+                    "the line is longer than {}, the limit for one line",
                     super::limits::bytes(max)
                 );
             }
@@ -98,14 +97,18 @@ impl<R: BufRead> BufRead for Checked<'_, R> {
             }
             self.out.clear();
             self.pos = 0;
-            let max = self.state.borrow().options.limits.line_bytes;
+            let max = {
+                let mut st = self.state.borrow_mut();
+                // The number of the line about to be read, for its errors.
+                st.line += 1;
+                st.options.limits.line_bytes
+            };
             let result = match self.next_line(max) {
-                Ok(false) => return Ok(&[]),
-                Ok(true) => {
-                    let mut st = self.state.borrow_mut();
-                    st.line += 1;
-                    check_line(&self.raw, &mut st, &mut self.out)
+                Ok(false) => {
+                    self.state.borrow_mut().line -= 1;
+                    return Ok(&[]);
                 }
+                Ok(true) => check_line(&self.raw, &mut self.state.borrow_mut(), &mut self.out),
                 Err(e) => Err(e),
             };
             if let Err(e) = result {
