@@ -1,13 +1,15 @@
-//! Property test of the scene loader on stable Rust (issue 14): thousands of
-//! files generated and mutated from a seed corpus (the Cornell box as glTF
-//! and as GLB, small GLBs with sparse accessors, textures and node DAGs),
-//! with a fixed seed. Every input must give a scene whose data is sane or an
+//! Property test of the scene loaders on stable Rust (issues 14 and 27):
+//! thousands of files generated and mutated from a seed corpus (the Cornell
+//! box as glTF and as GLB, small GLBs with sparse accessors, textures and
+//! node DAGs; small OBJ files naming MTL libraries and textures, mutated
+//! line by line and byte by byte), with a fixed seed. Every input must give a scene whose data is sane or an
 //! error, never a panic, a slow load (a hang) or a large allocation; the
 //! loader is called without its panic guard (`load_bytes`).
 //!
 //! Inputs that fail are written to `tests/fuzz-regressions/` (commit them);
 //! every file there is replayed first. `ISR_FUZZ_CASES=N` runs N mutated
-//! cases instead of the default; `ISR_FUZZ_SEED=S` changes the seed;
+//! cases instead of the default (`ISR_FUZZ_OBJ_CASES=N` for the OBJ
+//! loader); `ISR_FUZZ_SEED=S` changes the seed;
 //! `ISR_FUZZ_TRACE=1` writes each input to `target/fuzz-last.*` before it is
 //! loaded (to find the input that aborted the process, should one).
 mod common;
@@ -19,6 +21,7 @@ use common::measure::{peak_allocated, Counting};
 use common::temp_dir;
 use isr::scene::gltf_load::{load_bytes, LoadOptions};
 use isr::scene::limits::Limits;
+use isr::scene::obj_load;
 use mutate::{mutate_bytes, mutate_json, Rng};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -76,6 +79,10 @@ fn fixture_dir() -> PathBuf {
     std::fs::write(d.join("t.png"), small_png()).unwrap();
     std::fs::write(d.join("big.png"), png_header_only(4096, 4096)).unwrap();
     std::fs::create_dir_all(d.join("dir")).unwrap();
+    // Libraries the OBJ seeds (and their mutations) name.
+    for (name, mtl) in OBJ_LIBRARIES {
+        std::fs::write(d.join(name), mtl).unwrap();
+    }
     #[cfg(unix)]
     {
         let _ = std::process::Command::new("mkfifo")
@@ -126,6 +133,134 @@ fn corpus() -> Vec<(Value, Option<Vec<u8>>)> {
     out
 }
 
+/// MTL libraries in the fixture folder: good, naming a missing texture, a
+/// FIFO, a directory, a link out, a too-large header, naming itself, broken.
+const OBJ_LIBRARIES: &[(&str, &str)] = &[
+    (
+        "m.mtl",
+        "newmtl a\nKd 0.5 0.6 0.7\nmap_Kd t.png\nnewmtl b\nKd 1 0 0\nNs 10\n",
+    ),
+    ("gone.mtl", "newmtl a\nmap_Kd gone.png\n"),
+    ("pipe.mtl", "newmtl a\nmap_Kd pipe\n"),
+    ("dir.mtl", "newmtl a\nmap_Kd dir\n"),
+    ("link.mtl", "newmtl a\nmap_Kd link\n"),
+    ("big.mtl", "newmtl a\nmap_Kd big.png\n"),
+    ("self.mtl", "mtllib self.mtl\nnewmtl a\nKd 0.2 0.2 0.2\n"),
+    (
+        "broken.mtl",
+        "newmtl a\nKd 0.5\nKd 1 2\nmap_Kd -s 1 1\n\u{0}\n",
+    ),
+];
+
+/// OBJ seeds: a textured quad, polygons and relative indices, normals,
+/// several objects and materials.
+fn obj_corpus() -> Vec<String> {
+    vec![
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3 4/4\n".into(),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf -5 -4 -3 -2 -1\no second\nv 0 0 1\nv 1 0 1\nv 1 1 1\nf 6 7 8\n".into(),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvn 1 0 0\nusemtl b\nf 1//1 2//1 3//1\nusemtl a\nf 1//2 3//2 4//2\ng other\nusemtl missing\nf 2 3 4\n".into(),
+        "# crlf\r\nmtllib self.mtl\r\nv 0 0 0 1\r\nv 1 0 0 0.5\r\nv 0 1 0 1 0 0\r\ns 1\r\nl 1 2\r\nf 1 2 3\r\n".into(),
+    ]
+}
+
+/// A line-level change to an OBJ: a line dropped, repeated or cut, a
+/// number or index replaced by a hostile one, a statement inserted.
+fn mutate_obj(text: &mut String, rng: &mut Rng) {
+    let mut lines: Vec<String> = text.split('\n').map(str::to_string).collect();
+    let n = lines.len().max(1);
+    let k = rng.below(n);
+    const NUMBERS: &[&str] = &[
+        "0",
+        "-1",
+        "-9",
+        "9",
+        "1e39",
+        "-1e39",
+        "nan",
+        "inf",
+        "1e30",
+        "1e-30",
+        "4294967296",
+        "-2147483649",
+        "99999999999999999999",
+        "0x10",
+        "",
+        "1/",
+        "/1",
+        "1//",
+        "1/2/3/4",
+        "+3",
+    ];
+    const LINES: &[&str] = &[
+        "mtllib m.mtl",
+        "mtllib gone.mtl",
+        "mtllib pipe.mtl",
+        "mtllib dir.mtl",
+        "mtllib link.mtl",
+        "mtllib big.mtl",
+        "mtllib self.mtl",
+        "mtllib broken.mtl",
+        "mtllib ../m.mtl",
+        "mtllib /etc/passwd",
+        "mtllib fuzz.obj",
+        "mtllib dir",
+        "mtllib pipe",
+        "mtllib",
+        "usemtl a",
+        "usemtl",
+        "usemtl b",
+        "o",
+        "g a b",
+        "s off",
+        "vt 0.5",
+        "vn 0 0 0",
+        "v 1 2 3 4 5",
+        "f 1 1 1",
+        "f 1 2",
+        "f",
+        "l 1 2 3",
+        "p 1",
+        "curv 0 1 1 2",
+        "vp 0.5",
+        "\u{0}",
+        "\r",
+        "f 1/1/1 2/2/2 3/3/3",
+    ];
+    match rng.below(7) {
+        0 if lines.len() > 1 => {
+            lines.remove(k);
+        }
+        1 => {
+            let l = lines[k].clone();
+            lines.insert(k, l);
+        }
+        2 => {
+            let l = &mut lines[k];
+            let cut = rng.below(l.len() + 1);
+            if l.is_char_boundary(cut) {
+                l.truncate(cut);
+            }
+        }
+        3 | 4 => {
+            let words: Vec<String> = lines[k].split(' ').map(str::to_string).collect();
+            if words.len() > 1 {
+                let mut words = words;
+                let w = 1 + rng.below(words.len() - 1);
+                words[w] = rng.pick(NUMBERS).to_string();
+                lines[k] = words.join(" ");
+            }
+        }
+        5 => lines.insert(k, rng.pick(LINES).to_string()),
+        _ => {
+            // A long face, fanned.
+            let m = 3 + rng.below(200);
+            let face: Vec<String> = (0..m).map(|i| format!("{}", 1 + i % 4)).collect();
+            lines.insert(k, format!("f {}", face.join(" ")));
+        }
+    }
+    *text = lines.join("\n");
+}
+
 fn to_case(doc: &Value, bin: Option<&[u8]>) -> Case {
     match bin {
         Some(b) => Case {
@@ -152,7 +287,12 @@ fn check(dir: &Path, case: &Case) -> Result<Option<String>, String> {
     let started = Instant::now();
     let (result, peak) = peak_allocated(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            load_bytes(&path, &case.bytes, &options).map(|s| {
+            let loaded = if case.name.ends_with(".obj") {
+                obj_load::load_bytes(&path, &case.bytes, &options)
+            } else {
+                load_bytes(&path, &case.bytes, &options)
+            };
+            loaded.map(|s| {
                 // What the renderer does first with a scene.
                 let bounds = s.bounds();
                 let state = s.rest_state();
@@ -344,6 +484,7 @@ fn loader_never_panics_hangs_or_allocates_without_bound() {
             let name = match p.extension().and_then(|e| e.to_str()) {
                 Some("gltf") => "fuzz.gltf",
                 Some("glb") => "fuzz.glb",
+                Some("obj") => "fuzz.obj",
                 _ => continue,
             };
             let bytes = std::fs::read(&p).unwrap();
@@ -427,6 +568,49 @@ fn loader_never_panics_hangs_or_allocates_without_bound() {
             break;
         }
     }
+    // The OBJ loader: its seeds load, then mutated cases.
+    let obj_seeds = obj_corpus();
+    for seed in &obj_seeds {
+        let options = LoadOptions {
+            limits: FUZZ_LIMITS,
+            ..Default::default()
+        };
+        if let Err(e) = obj_load::load_bytes(&dir.join("fuzz.obj"), seed.as_bytes(), &options) {
+            panic!("an OBJ seed does not load: {e:#}\n{seed}");
+        }
+    }
+    let obj_cases: usize = std::env::var("ISR_FUZZ_OBJ_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10_000);
+    let mut obj_scenes = 0usize;
+    for i in 0..obj_cases {
+        let mut text = rng.pick(&obj_seeds).clone();
+        for _ in 0..1 + rng.below(4) {
+            mutate_obj(&mut text, &mut rng);
+        }
+        let mut bytes = text.into_bytes();
+        if i % 4 == 0 {
+            mutate_bytes(&mut bytes, &mut rng);
+        }
+        let case = Case {
+            name: "fuzz.obj",
+            bytes,
+        };
+        match run(case, true, &mut failures) {
+            Some(None) => obj_scenes += 1,
+            Some(Some(e)) => {
+                let e = e.split(": ").skip(1).take(2).collect::<Vec<_>>().join(": ");
+                let key: String = e.chars().take(60).collect();
+                *messages.entry(format!("obj: {key}")).or_insert(0usize) += 1;
+            }
+            None => {}
+        }
+        if failures.len() > 20 {
+            break;
+        }
+    }
+    println!("fuzz_loader: {obj_cases} mutated OBJ cases, {obj_scenes} of them scenes");
     let mut common: Vec<_> = messages.into_iter().collect();
     common.sort_by_key(|c| std::cmp::Reverse(c.1));
     for (m, n) in common.iter().take(15) {
