@@ -217,10 +217,13 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         );
     }
     let d: Description = serde_json::from_slice(bytes).map_err(|e| {
+        let at = format!(" at line {} column {}", e.line(), e.column());
+        let message = e.to_string();
         anyhow!(
-            "line {} column {}: {e} (the format: README, \"Scenes from the archives\")",
+            "line {} column {}: {} (the format: README, \"Scenes from the archives\")",
             e.line(),
-            e.column()
+            e.column(),
+            message.strip_suffix(&at).unwrap_or(&message)
         )
     })?;
     let folder = path
@@ -487,6 +490,16 @@ fn vec3(a: [f32; 3], what: &str) -> Result<Vec3> {
     Ok(v)
 }
 
+/// A position, within the coordinate budget (`Limits::coordinate`).
+fn point(a: [f32; 3], what: &str) -> Result<Vec3> {
+    let v = vec3(a, what)?;
+    let limit = super::limits::Limits::DEFAULT.coordinate;
+    if v.abs().max_element() > limit {
+        bail!("{what} {a:?} reaches beyond {limit:.0e} m, the largest coordinate isr supports");
+    }
+    Ok(v)
+}
+
 /// One keyframe resolved: time, position, where it points.
 struct Pose {
     t: f32,
@@ -522,12 +535,12 @@ fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<Pose>>)> {
             }
         }
         LightKind::Spot | LightKind::Point => {
-            let p = vec3(
+            let p = point(
                 position.ok_or_else(|| anyhow!("a {} light needs a position", spec.kind))?,
                 "position",
             )?;
             let d = match (target, direction) {
-                (Some(t), _) => vec3(t, "target")? - p,
+                (Some(t), _) => point(t, "target")? - p,
                 (None, Some(d)) => vec3(d, "direction")?,
                 (None, None) if kind == LightKind::Point => -Vec3::Y,
                 (None, None) => bail!("a spot light needs a target (or a direction) to point at"),
@@ -608,10 +621,10 @@ fn camera(spec: &CameraSpec, pivot: Vec3, diagonal: f32) -> Result<(Camera, Opti
         .position
         .or(first.and_then(|k| k.position))
         .ok_or_else(|| anyhow!("the camera needs a position"))?;
-    let position = vec3(position, "position")?;
+    let position = point(position, "position")?;
     let target = spec.target.or(first.and_then(|k| k.target));
     let target = match target {
-        Some(t) => vec3(t, "target")?,
+        Some(t) => point(t, "target")?,
         None => pivot,
     };
     let Some(direction) = (target - position).try_normalize() else {
@@ -678,10 +691,10 @@ fn motion(
                     bail!("{}", what(&format!("t {} is not finite", k.t)));
                 }
                 if let Some(p) = k.position {
-                    position = vec3(p, &what("position"))?;
+                    position = point(p, &what("position"))?;
                 }
                 if let Some(t) = k.target {
-                    target = Some(vec3(t, &what("target"))?);
+                    target = Some(point(t, &what("target"))?);
                 }
                 if let Some(d) = k.direction {
                     direction = vec3(d, &what("direction"))?;
