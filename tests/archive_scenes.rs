@@ -296,7 +296,8 @@ fn pick_up(n: Vec3) -> Vec3 {
     }
 }
 
-/// `--scenes archive` is the four scenes at their own 64x64 and 3 frames,
+/// `--scenes archive` is the four scenes at their own 64x64 (RSM 128) and
+/// 3 frames,
 /// unless the command line sets the size or frames.
 #[test]
 fn the_bench_runs_the_archive_scenes_at_their_own_size() {
@@ -311,7 +312,7 @@ fn the_bench_runs_the_archive_scenes_at_their_own_size() {
         let p = plan.for_scene(s);
         assert_eq!(
             (p.base.width, p.base.height, p.base.rsm_resolution, p.frames),
-            (64, 64, 64, 3)
+            (64, 64, 128, 3)
         );
     }
     let args = isr::bench::BenchArgs {

@@ -11,6 +11,7 @@ pub mod report;
 pub mod rows;
 pub mod scenes;
 pub mod sweep;
+pub mod truth;
 
 use crate::readback::Readback;
 use crate::renderer::{FrameStats, Renderer};
@@ -96,16 +97,16 @@ pub struct Plan {
 }
 
 /// A scene of the run: its name, how it is made, its animation window, and
-/// the size (width = height = RSM) and frames it is benched at where they
-/// are not the run's (the archive scenes', unless the command line sets
-/// them).
+/// the size (image width = height, RSM) and frames it is benched at where
+/// they are not the run's (the archive scenes', unless the command line
+/// sets them).
 #[derive(Clone, Debug)]
 pub struct SceneSpec {
     pub name: String,
     pub file: Option<PathBuf>,
     pub start: f32,
     pub fps: f32,
-    pub size: Option<u32>,
+    pub size: Option<(u32, u32)>,
     pub frames: Option<u32>,
 }
 
@@ -238,8 +239,8 @@ impl Plan {
     /// The plan of scene `s`: the run's, at the scene's own size and frames.
     pub fn for_scene(&self, s: &SceneSpec) -> Plan {
         let mut p = self.clone();
-        if let Some(n) = s.size {
-            (p.base.width, p.base.height, p.base.rsm_resolution) = (n, n, n);
+        if let Some((n, rsm)) = s.size {
+            (p.base.width, p.base.height, p.base.rsm_resolution) = (n, n, rsm);
         }
         p.frames = s.frames.unwrap_or(p.frames);
         p
