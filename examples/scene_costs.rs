@@ -7,7 +7,9 @@
 //!     cargo run --release --example scene_costs [-- SIZE RSM FRAMES]
 //!
 //! SIZE x SIZE pixels (default 128), RSM (default 128), FRAMES frames timed
-//! per method (default 5); the path tracer at 32x32, 16 samples per pixel.
+//! per method (default 5); the path tracer at PT x PT pixels, SPP samples
+//! per pixel (defaults 64 and 16: its progress reporter wakes every 250 ms,
+//! so a render of less than a second is timed to within that).
 //! The archive scenes need the archive folder (ISR_SCENES).
 
 use isr::bench::scenes;
@@ -35,6 +37,8 @@ fn main() -> anyhow::Result<()> {
     let size = args.first().copied().unwrap_or(128);
     let rsm = args.get(1).copied().unwrap_or(128);
     let frames = args.get(2).copied().unwrap_or(5);
+    let pt = args.get(3).copied().unwrap_or(64);
+    let spp = args.get(4).copied().unwrap_or(16);
     let gpu = Gpu::new(&GpuOptions::default())?;
     println!("device: {} ({}); {size}x{size}, RSM {rsm}, {frames} frames (medians of all but the counting one)\n", gpu.info.name, gpu.info.driver);
     let names: Vec<&str> = scenes::SCENES
@@ -118,9 +122,9 @@ fn main() -> anyhow::Result<()> {
         let _ = isr::pathtrace::render(
             &posed,
             &isr::pathtrace::PathTraceSettings {
-                width: 32,
-                height: 32,
-                spp: 16,
+                width: pt,
+                height: pt,
+                spp,
                 seed: 1,
                 exposure: 1.0,
             },
@@ -140,7 +144,7 @@ fn main() -> anyhow::Result<()> {
         ));
     }
     println!("## Load, memory, path tracer\n");
-    println!("| scene | triangles | vertices | load ms | GPU MiB (none) | GPU MiB (hisr) | BVH build ms | pathtrace 32x32x16 ms (build included) |");
+    println!("| scene | triangles | vertices | load ms | GPU MiB (none) | GPU MiB (hisr) | BVH build ms | pathtrace {pt}x{pt}, {spp} spp, ms (build included) |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for (name, tri, vert, load, mem, _, bvh, pt) in &rows {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;
