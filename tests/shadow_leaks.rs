@@ -8,6 +8,7 @@ mod common;
 
 use common::*;
 use glam::Vec3;
+use isr::bench::truth::{truth_mask, ShadowMaps, TruthMask};
 use isr::readback::Readback;
 use isr::scene::{cuboid, Camera, Light, Scene};
 
@@ -50,34 +51,20 @@ fn court(light: Light) -> Scene {
     s
 }
 
-/// Pixels with geometry whose 3x3 neighbourhood has the same surface
-/// (normals within 1e-2, view depths within 5%) and no exact shadow edge.
-fn away_from_edges(raster: &Readback, traced: &Readback) -> Vec<bool> {
-    let (w, h) = (raster.width as i32, raster.height as i32);
-    let at = |x: i32, y: i32| (y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize;
-    let mut mask = vec![false; (w * h) as usize];
-    for y in 0..h {
-        for x in 0..w {
-            let k = at(x, y);
-            let p = raster.position[k];
-            if p[3] <= 0.0 {
-                continue;
-            }
-            mask[k] = (-1..=1).all(|dy| {
-                (-1..=1).all(|dx| {
-                    let q = at(x + dx, y + dy);
-                    let (a, b) = (raster.normal[k], raster.normal[q]);
-                    let dn: f32 = (0..3).map(|c| (a[c] - b[c]).abs()).sum();
-                    let depth = raster.position[q][3];
-                    depth > 0.0
-                        && dn < 1e-2
-                        && (depth - p[3]).abs() < 0.05 * p[3]
-                        && (traced.direct[q][0] > 0.0) == (traced.direct[k][0] > 0.0)
-                })
-            });
-        }
-    }
-    mask
+/// The pixels compared (`isr::bench::truth::truth_mask`), and how many
+/// were left out at geometric and at shadow edges.
+fn compared(
+    r: &Rendered,
+    traced: &Readback,
+    settings: &isr::settings::RenderSettings,
+) -> TruthMask {
+    let shadows = ShadowMaps::new(
+        &r.light_views,
+        r.origin,
+        settings.rsm_resolution,
+        settings.pcf_radius,
+    );
+    truth_mask(&r.readback, &traced.direct, &shadows)
 }
 
 #[test]
@@ -105,7 +92,9 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
     ];
     for (name, light) in lights {
         let scene = court(light);
-        let raster = render(&gpu, &scene, &sized("none", n, n, 512), 1).readback;
+        let settings = sized("none", n, n, 512);
+        let rendered = render(&gpu, &scene, &settings, 1);
+        let raster = &rendered.readback;
         let traced = isr::pathtrace::render(
             &scene,
             &isr::pathtrace::PathTraceSettings {
@@ -117,8 +106,9 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
             },
             |_, _| {},
         );
-        let mask = away_from_edges(&raster, &traced);
-        let kept = mask.iter().filter(|m| **m).count();
+        let compared = compared(&rendered, &traced, &settings);
+        let mask = &compared.mask;
+        let kept = compared.kept();
         let lit = (0..mask.len())
             .filter(|&k| mask[k] && traced.direct[k][0] > 0.0)
             .count();
@@ -129,7 +119,7 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
         let leaks = (0..mask.len())
             .filter(|&k| mask[k] && traced.direct[k][0] == 0.0 && raster.direct[k][0] > 0.01)
             .count();
-        let e = relative_rmse(&raster.direct, &traced.direct, &mask);
+        let e = relative_rmse(&raster.direct, &traced.direct, mask);
         println!("{name}: direct within {e:.4} over {kept} pixels ({lit} lit, {shadowed} shadowed), {leaks} leaking");
         // Both lit and shadowed floor in view, most of the image compared.
         assert!(
@@ -140,6 +130,102 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
             e < 0.01,
             "{name}: direct light {e:.4} from the path tracer's"
         );
+        assert!(
+            leaks * 100 < shadowed,
+            "{name}: {leaks} of {shadowed} shadowed pixels lit"
+        );
+    }
+}
+
+/// The Sibenik cathedral (73,564 triangles, 40 m long) lit from the middle of
+/// the nave at half its height (issue 26, part 5: a spot there lit about
+/// 1,000 shadowed pixels of the galleries and arcades, 19% from the path
+/// tracer with 5.6% too much energy). Faces the light grazes (cos < 0.1)
+/// are counted apart: within one texel of their own depth slope the shadow
+/// test cannot tell an occluder from the face, so a grazing face beside an
+/// occluder is lit at its (small) unshadowed value.
+#[test]
+fn direct_light_in_the_sibenik_cathedral_matches_the_path_tracer_away_from_edges() {
+    let gpu = gpu();
+    let n = 256;
+    let path = isr::scene::description::archive_root().join("sibenik/sibenik.obj");
+    let mut scene = isr::scene::load_file(&path, &Default::default())
+        .unwrap_or_else(|e| panic!("{e:#}: {}", isr::scene::description::archive_hint()));
+    if !gpu.features.sampled_image_array_indexing {
+        isr::scene::one_texture::keep_one(&mut scene);
+    }
+    scene.camera = Camera::look_at(
+        Vec3::new(-17.0, -8.0, 0.0),
+        Vec3::new(8.0, -4.0, 0.0),
+        Vec3::Y,
+        60f32.to_radians(),
+        0.05,
+    );
+    let hung = Vec3::new(0.0, 0.0, 0.0);
+    let lights = [
+        (
+            "a spot hung in the nave",
+            spot(hung, Vec3::new(0.0, -12.0, 0.0), 1500.0, 45.0, 60.0),
+        ),
+        ("a point light hung in the nave", point(hung, 300.0)),
+    ];
+    for (name, light) in lights {
+        scene.lights = vec![light];
+        let settings = sized("none", n, n, 512);
+        let rendered = render(&gpu, &scene, &settings, 1);
+        let raster = &rendered.readback;
+        let traced = isr::pathtrace::render(
+            &scene,
+            &isr::pathtrace::PathTraceSettings {
+                width: n,
+                height: n,
+                spp: 1,
+                seed: 1,
+                exposure: 1.0,
+            },
+            |_, _| {},
+        );
+        let compared = compared(&rendered, &traced, &settings);
+        let mask = &compared.mask;
+        let kept = compared.kept();
+        let shadowed = (0..mask.len())
+            .filter(|&k| mask[k] && traced.direct[k][0] == 0.0)
+            .count();
+        let grazed = |k: usize| {
+            let p = Vec3::from_slice(&raster.position[k][..3]);
+            let normal = Vec3::from_slice(&raster.normal[k][..3]).normalize();
+            normal.dot((light.position - p).normalize()) < 0.1
+        };
+        let leaking: Vec<usize> = (0..mask.len())
+            .filter(|&k| mask[k] && traced.direct[k][0] == 0.0 && raster.direct[k][0] > 0.01)
+            .collect();
+        let grazing = leaking.iter().filter(|&&k| grazed(k)).count();
+        let leaks = leaking.len() - grazing;
+        let e = relative_rmse(&raster.direct, &traced.direct, mask);
+        let energy = |d: &[[f32; 4]]| {
+            (0..mask.len())
+                .filter(|&k| mask[k])
+                .map(|k| d[k][..3].iter().map(|&c| c as f64).sum::<f64>())
+                .sum::<f64>()
+        };
+        let ratio = energy(&raster.direct) / energy(&traced.direct);
+        println!(
+            "{name}: direct within {e:.4}, energy x{ratio:.4}, over {kept} pixels \
+             ({:.0}% left out: {} at geometric edges, {} at shadow edges), \
+             {shadowed} shadowed, {leaks} leaking ({grazing} more on grazed faces)",
+            100.0 * compared.left_out(),
+            compared.geometric_edges,
+            compared.shadow_edges
+        );
+        assert!(
+            kept * 10 > (n * n) as usize && shadowed > 2000,
+            "{name}: {kept} pixels compared, {shadowed} shadowed"
+        );
+        assert!(
+            e < 0.01,
+            "{name}: direct light {e:.4} from the path tracer's"
+        );
+        assert!((ratio - 1.0).abs() < 0.01, "{name}: energy x{ratio:.4}");
         assert!(
             leaks * 100 < shadowed,
             "{name}: {leaks} of {shadowed} shadowed pixels lit"

@@ -103,6 +103,8 @@ pub struct Rendered {
     pub uniforms: isr::gpu_types::FrameUniforms,
     /// The render origin (`isr::scene::render_origin`).
     pub origin: glam::DVec3,
+    /// The RSMs of the last frame (matrices relative to `origin`).
+    pub light_views: Vec<isr::view::LightView>,
 }
 
 /// Renders `frames` frames of `scene` and reads the results back, checking
@@ -113,6 +115,7 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) 
     let readback = r.readback().expect("readback");
     let uniforms = r.frame_uniforms();
     let origin = r.render_origin();
+    let light_views = r.light_views().to_vec();
     drop(r);
     assert_validation_clean(gpu);
     Rendered {
@@ -120,6 +123,7 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, frames: u32) 
         stats,
         uniforms,
         origin,
+        light_views,
     }
 }
 
