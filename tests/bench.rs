@@ -121,6 +121,8 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
         "results.csv",
         "speed_vs_error.svg",
         "speed_vs_error.png",
+        "speed_vs_truth.svg",
+        "speed_vs_truth.png",
         "flicker.svg",
         "flicker.png",
         "passes.svg",
@@ -157,7 +159,23 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
         if r["method"] != "reference" {
             assert!(r["flicker"].as_f64().is_some(), "flicker in {r}");
         }
+        // Every row against the path-traced truth too; the reference's is
+        // the model error, with what the truth was (quick: noise under 0.1).
+        let t = &r["truth"];
+        assert!(
+            t["rel_rmse_indirect"].as_f64().is_some_and(|e| e > 0.0),
+            "truth in {r}"
+        );
+        if r["method"] == "reference" {
+            let noise = t["noise"].as_f64().unwrap();
+            let left_out = t["left_out"].as_f64().unwrap();
+            assert!(noise > 0.0 && noise <= 0.1, "{t}");
+            assert!(t["spp"].as_f64().unwrap() >= 32.0, "{t}");
+            assert!(left_out > 0.0 && left_out < 0.95, "{t}");
+        }
     }
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(report.contains("## Model error") && report.contains("RMSE truth"));
     errors_fall_as_the_cost_rises(rows);
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
@@ -169,6 +187,8 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     // A second run finds every row in the journal and renders nothing.
     let journal = dir.join("rows.jsonl");
     let before = lines(&journal);
+    let truth = dir.join("truth/slats/frame-2.exr");
+    let traced = std::fs::metadata(&truth).unwrap().modified().unwrap();
     Isr::new("bench")
         .args(["--quick", "--out-dir", d])
         .succeeds();
@@ -181,6 +201,11 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
         .args(["--quick", "--out-dir", d, "--scenes", "slats"])
         .succeeds();
     assert_eq!(lines(&journal), before);
+    // The truth was read back, not traced again.
+    assert_eq!(
+        std::fs::metadata(&truth).unwrap().modified().unwrap(),
+        traced
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -208,5 +233,10 @@ fn bad_names_list_the_valid_ones() {
     // Nothing was rendered, and no panic (exit status 1, `clean_failure`).
     let err = fails(&["--rsm", "100"]);
     assert!(err.contains("power of two"), "{err}");
+    let err = fails(&["--truth-noise", "1.5"]);
+    assert!(
+        err.contains("--truth-noise 1.5") && err.contains("0.02"),
+        "{err}"
+    );
     assert!(!dir.join("rows.jsonl").exists());
 }

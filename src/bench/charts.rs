@@ -125,7 +125,9 @@ fn front(sorted: &[(f64, f64)]) -> Vec<(f64, f64)> {
 }
 
 /// Panels of (x, y) curves, one per method over its sweep, log-log: a line
-/// along the method's front (`front`), a dot per point.
+/// along the method's front (`front`), a dot per point. With `reference`,
+/// the dense reference's y is a dashed line across each panel (against
+/// the truth: the model error, which no VPL method goes far below).
 fn curves<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Row],
@@ -133,6 +135,7 @@ fn curves<DB: DrawingBackend>(
     title: &str,
     y_label: &str,
     y: &dyn Fn(&Row) -> Option<f64>,
+    reference: bool,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
@@ -158,8 +161,12 @@ where
                 row.indirect_ms.is_some_and(|v| v > 0.0) && y(row).is_some_and(|v| v > 0.0)
             })
             .collect();
+        let floor = rows
+            .iter()
+            .filter(|row| reference && &row.scene == scene && row.method == "reference")
+            .find_map(|row| y(row).filter(|v| *v > 0.0));
         let xr = log_range(pts.iter().filter_map(|r| r.indirect_ms));
-        let yr = log_range(pts.iter().filter_map(|r| y(r)));
+        let yr = log_range(pts.iter().filter_map(|r| y(r)).chain(floor));
         let mut chart = ChartBuilder::on(panel)
             .caption(scene, ("sans-serif", 18))
             .margin(8)
@@ -206,6 +213,19 @@ where
                 });
             chart
                 .draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        if let Some(v) = floor {
+            let ends = vec![(xr.start, v), (xr.end, v)];
+            chart
+                .draw_series(DashedLineSeries::new(ends, 6, 4, BLACK.stroke_width(1)))
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!("dense reference {}", short(v)),
+                    (xr.start * 1.05, v),
+                    ("sans-serif", 11).into_font().color(&BLACK),
+                )))
                 .map_err(|e| anyhow!("{e}"))?;
         }
         if free.is_none() {
@@ -302,8 +322,45 @@ pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
     both(
         &dir.join("speed_vs_error"),
         size,
-        &|a| curves(a, rows, scenes, title, "relative RMSE (indirect)", &y),
-        &|a| curves(a, rows, scenes, title, "relative RMSE (indirect)", &y),
+        &|a| {
+            curves(
+                a,
+                rows,
+                scenes,
+                title,
+                "relative RMSE (indirect)",
+                &y,
+                false,
+            )
+        },
+        &|a| {
+            curves(
+                a,
+                rows,
+                scenes,
+                title,
+                "relative RMSE (indirect)",
+                &y,
+                false,
+            )
+        },
+    )
+}
+
+/// `speed_vs_truth.svg/.png`: indirect ms against relative RMSE of the
+/// indirect image against the path-traced truth, over the pixels its mask
+/// keeps, with the dense reference's (section 6.6).
+pub fn speed_vs_truth(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
+    let (r, c) = grid(scenes.len());
+    let size = (480 * c as u32, 400 * r as u32 + 40);
+    let title = "indirect time against error from the path-traced truth (log-log)";
+    let y = |r: &Row| r.truth.rel_rmse_indirect;
+    let label = "relative RMSE against the truth";
+    both(
+        &dir.join("speed_vs_truth"),
+        size,
+        &|a| curves(a, rows, scenes, title, label, &y, true),
+        &|a| curves(a, rows, scenes, title, label, &y, true),
     )
 }
 
@@ -316,8 +373,8 @@ pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     both(
         &dir.join("flicker"),
         size,
-        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y),
-        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y),
+        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y, false),
+        &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y, false),
     )
 }
 

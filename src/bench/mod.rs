@@ -1,6 +1,6 @@
 //! `isr bench`: every method over its parameter sweep on the stress scenes,
-//! against the dense reference of the same frame (docs/algorithm.md section
-//! 6), written as `results.json`, `results.csv`, charts, a gallery and
+//! against the dense reference of the same frame and the path-traced truth
+//! (docs/algorithm.md section 6), written as `results.json`, `results.csv`, charts, a gallery and
 //! `report.md` into one folder. Rows are journalled to `rows.jsonl` as they
 //! finish, so an interrupted run resumes where it stopped.
 
@@ -56,6 +56,12 @@ pub struct BenchArgs {
     /// The CI smoke test: two small scenes, a few settings per method, 64x64.
     #[arg(long)]
     pub quick: bool,
+    /// The path-traced truth's noise target: samples are added until the
+    /// relative RMSE of its Monte Carlo noise over the compared pixels is
+    /// under this (default 0.02, about 15,000 samples per pixel on the
+    /// stress scenes; quick 0.1). 0 traces no truth.
+    #[arg(long)]
+    pub truth_noise: Option<f64>,
     /// Vulkan device index (`isr devices`).
     #[arg(long)]
     pub device: Option<usize>,
@@ -77,6 +83,7 @@ impl Default for BenchArgs {
             timing_frames: None,
             out_dir: "out/bench".into(),
             quick: false,
+            truth_noise: None,
             device: None,
             params: Default::default(),
         }
@@ -94,6 +101,8 @@ pub struct Plan {
     pub quick: bool,
     pub out_dir: PathBuf,
     pub device: Option<usize>,
+    /// The truth's noise target; `None`: no truth.
+    pub truth_noise: Option<f64>,
 }
 
 /// A scene of the run: its name, how it is made, its animation window, and
@@ -216,6 +225,14 @@ impl BenchArgs {
         if frames == 0 || frames > 1000 || timing_frames == 0 || timing_frames > 1000 {
             bail!("--frames and --timing-frames must be within 1..=1000");
         }
+        let truth_noise = self
+            .truth_noise
+            .unwrap_or(if q { 0.1 } else { truth::NOISE_TARGET });
+        if !(0.0..1.0).contains(&truth_noise) {
+            bail!(
+                "--truth-noise {truth_noise}: the path-traced truth's noise target must be at least 0 (no truth) and under 1; 0.02 is the default"
+            );
+        }
         Ok(Plan {
             scenes: specs,
             methods,
@@ -231,6 +248,7 @@ impl BenchArgs {
             quick: q,
             out_dir: self.out_dir.clone(),
             device: self.device,
+            truth_noise: (truth_noise > 0.0).then_some(truth_noise),
         })
     }
 }
@@ -257,8 +275,12 @@ impl Plan {
     /// The journal key of a row.
     pub fn key(&self, scene: &str, method: &str, label: &str) -> String {
         let b = &self.base;
+        // The truth's noise too: its errors are part of the row.
+        let truth = self
+            .truth_noise
+            .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         format!(
-            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed",
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}",
             b.width, b.height, b.rsm_resolution, self.frames, self.timing_frames
         )
     }
@@ -280,12 +302,20 @@ impl Plan {
 const REFERENCE_LABEL: &str = "every RSM texel";
 const REFERENCE: Method = crate::methods::reference::KEY;
 
-/// One frame of the dense reference, what every method is compared with.
+/// One frame of the dense reference, what every method is compared with,
+/// and of the path-traced truth where points are measured.
 struct RefFrame {
     indirect: Vec<[f32; 4]>,
     final_radiance: Vec<[f32; 4]>,
     mask: Vec<bool>,
     display: Vec<u8>,
+    truth: Option<TruthFrame>,
+}
+
+/// The path-traced truth's indirect image and the pixels it is compared on.
+struct TruthFrame {
+    indirect: Vec<[f32; 4]>,
+    mask: Vec<bool>,
 }
 
 /// The total the GPU allocator has handed out, in bytes.
@@ -400,7 +430,14 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
         } else {
             plan.frames
         };
+        // The truth is traced with the reference where anything is measured.
+        let truth_frames = if plan.truth_noise.is_none() || (todo.is_empty() && !ref_row) {
+            0
+        } else {
+            plan.frames
+        };
         units += ref_frames as u64
+            + truth_frames as u64
             + plan.frames as u64 * todo.len() as u64
             + image_frames as u64 * redraw.len() as u64;
         pending.push((
@@ -482,9 +519,11 @@ fn run_scene(
 ) -> Result<()> {
     let ref_row = work.ref_row;
     let images = plan.out_dir.join("images").join(&spec.name);
-    // The dense reference of every frame, once.
+    let with_truth = plan.truth_noise.is_some() && (ref_row || !work.todo.is_empty());
+    // The dense reference of every frame, once, and its path-traced truth.
     let mut refs = Vec::with_capacity(plan.frames as usize);
     let mut ref_stats = FrameStats::default();
+    let mut model = rows::TruthErrors::default();
     {
         let settings = settings_of(plan, REFERENCE);
         let mut r = Renderer::new(gpu, scene, &settings)?;
@@ -495,10 +534,28 @@ fn run_scene(
                 k + 1,
                 work.ref_frames
             ));
-            r.update(&scene.pose_at(frame_time(spec, k))?)?;
+            let state = scene.pose_at(frame_time(spec, k))?;
+            r.update(&state)?;
             let last = k + 1 == plan.frames;
             ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
             let out = r.readback()?;
+            let truth = if with_truth {
+                let t = frame_truth(plan, spec, k, &state.pose(scene), &r, &out, bar)?;
+                let n = plan.frames as f64;
+                let e = metrics::relative_rmse(&out.indirect, &t.image.indirect, &t.mask.mask);
+                let add = |v: &mut Option<f64>, x: f64| *v = Some(v.unwrap_or(0.0) + x / n);
+                add(&mut model.rel_rmse_indirect, e);
+                add(&mut model.spp, t.spp as f64);
+                add(&mut model.noise, t.noise);
+                add(&mut model.left_out, t.mask.left_out());
+                bar.inc(1);
+                Some(TruthFrame {
+                    indirect: t.image.indirect,
+                    mask: t.mask.mask,
+                })
+            } else {
+                None
+            };
             if k == plan.frames / 2 {
                 crate::output::write_png(
                     &images.join("reference.png"),
@@ -512,6 +569,7 @@ fn run_scene(
                 indirect: out.indirect,
                 final_radiance: out.final_radiance,
                 display: out.display,
+                truth,
             });
             bar.inc(1);
         }
@@ -521,6 +579,7 @@ fn run_scene(
         row.label = REFERENCE_LABEL.into();
         row.key = plan.key(&spec.name, "reference", REFERENCE_LABEL);
         row.is_default = true;
+        row.truth = model;
         rows::append(journal, &row)?;
     }
     // The allocator's total without any indirect method, to subtract.
@@ -548,6 +607,7 @@ fn run_scene(
         let mut flicker = metrics::Flicker::default();
         let mut flicker_final = metrics::Flicker::default();
         let (mut e_ind, mut e_fin, mut e_flip) = (0.0, 0.0, 0.0);
+        let mut e_truth = None;
         let mut evals = None;
         for k in 0..frames {
             bar.set_message(format!(
@@ -569,6 +629,10 @@ fn run_scene(
             let out = r.readback()?;
             let reference = &refs[k as usize];
             e_ind += metrics::relative_rmse(&out.indirect, &reference.indirect, &reference.mask);
+            if let Some(t) = &reference.truth {
+                let e = metrics::relative_rmse(&out.indirect, &t.indirect, &t.mask);
+                e_truth = Some(e_truth.unwrap_or(0.0) + e);
+            }
             e_fin += metrics::relative_rmse(
                 &out.final_radiance,
                 &reference.final_radiance,
@@ -618,6 +682,7 @@ fn run_scene(
         row.is_default = c.is_default(&plan.base);
         row.rel_rmse_indirect = e_ind / f;
         row.rel_rmse_final = e_fin / f;
+        row.truth.rel_rmse_indirect = e_truth.map(|e| e / f);
         row.flip = e_flip / f;
         row.flicker = flicker.flicker();
         row.flicker_second = flicker.second_difference();
@@ -723,5 +788,49 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         flicker_second: None,
         flicker_final: None,
         gpu_memory_bytes: None,
+        truth: Default::default(),
     }
+}
+
+/// The path-traced truth of frame `k` of `spec` at the run's noise target,
+/// cached in the run's folder (`truth/SCENE/frame-K.exr`, with a note of
+/// its samples and noise), compared on the pixels of `g` (the reference's
+/// G-buffer, whose RSMs `r` holds) away from edges.
+fn frame_truth(
+    plan: &Plan,
+    spec: &SceneSpec,
+    k: u32,
+    posed: &Scene,
+    r: &Renderer,
+    g: &Readback,
+    bar: &indicatif::ProgressBar,
+) -> Result<truth::Truth> {
+    let key = truth::FrameKey {
+        time: frame_time(spec, k),
+        target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
+        seed: k as u64 + 1,
+    };
+    let path = plan
+        .out_dir
+        .join("truth")
+        .join(&spec.name)
+        .join(format!("frame-{k}.exr"));
+    let shadows = truth::ShadowMaps::new(
+        r.light_views(),
+        r.render_origin(),
+        plan.base.rsm_resolution,
+        plan.base.pcf_radius,
+    );
+    let message = |spp: u32, noise: f64| {
+        bar.set_message(format!(
+            "{}: path-traced truth, frame {}/{}: {spp} spp, noise {:.1}%",
+            spec.name,
+            k + 1,
+            plan.frames,
+            100.0 * noise
+        ))
+    };
+    message(0, f64::NAN);
+    truth::frame_truth(&path, posed, g, &shadows, key, message)
+        .with_context(|| format!("the path-traced truth of {} frame {k}", spec.name))
 }

@@ -213,8 +213,9 @@ pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio]) -> String {
     let mut md = format!(
         "# isr bench\n\nDevice: **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
 (1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
-section 6.2), errors means over frames against the dense reference of the same frame (section 6.1), \
-flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (section 6.4).{}\n\n",
+section 6.2), errors means over frames against the dense reference of the same frame (section 6.1) \
+and against the path-traced truth (section 6.6), flicker over the sequence (section 6.3), FLIP on the \
+tone-mapped final image (section 6.4).{}\n\n",
         o.device,
         o.driver,
         b.width,
@@ -224,8 +225,11 @@ flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (se
         plan.timing_frames,
         if plan.quick { " Quick run (smoke test)." } else { "" }
     );
-    md += "![speed against error](speed_vs_error.svg)\n\n![flicker](flicker.svg)\n\n\
-![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n## Ratios\n\n\
+    md += "![speed against error](speed_vs_error.svg)\n\n\
+![speed against error from the truth](speed_vs_truth.svg)\n\n![flicker](flicker.svg)\n\n\
+![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n";
+    md += &model_errors(plan, o);
+    md += "\n## Ratios\n\n\
 | scene | measure | value | detail |\n| --- | --- | ---: | --- |\n";
     for r in ratios {
         md += &format!(
@@ -238,13 +242,13 @@ flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (se
     }
     for s in &plan.scenes {
         md += &format!(
-            "\n## {}\n\n| method | setting | indirect ms (min) | total ms | RMSE indirect | RMSE final | FLIP | flicker | light-patch evals | memory MiB |\n\
-| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
+            "\n## {}\n\n| method | setting | indirect ms (min) | total ms | RMSE indirect | RMSE truth | RMSE final | FLIP | flicker | light-patch evals | memory MiB |\n\
+| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
             s.name
         );
         for r in o.rows.iter().filter(|r| r.scene == s.name) {
             md += &format!(
-                "| {}{} | {} | {} ({}) | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} |\n",
+                "| {}{} | {} | {} ({}) | {} | {:.4} | {} | {:.4} | {:.4} | {} | {} | {} |\n",
                 r.method,
                 if r.is_default { " *" } else { "" },
                 r.label,
@@ -252,6 +256,7 @@ flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (se
                 cell(r.indirect_ms_min.map(|v| format!("{v:.1}"))),
                 cell(r.total_ms.map(|v| format!("{v:.1}"))),
                 r.rel_rmse_indirect,
+                cell(r.truth.rel_rmse_indirect.map(|v| format!("{v:.4}"))),
                 r.rel_rmse_final,
                 r.flip,
                 cell(r.flicker.map(|v| format!("{v:.4}"))),
@@ -267,6 +272,38 @@ flicker over the sequence (section 6.3), FLIP on the tone-mapped final image (se
     md
 }
 
+/// Each scene's model error: the dense reference against the path-traced
+/// truth, what every VPL method shares (it ignores indirect visibility),
+/// with how the truth was made and what its mask left out.
+fn model_errors(plan: &Plan, o: &Outcome) -> String {
+    let mut md = "## Model error\n\nThe dense reference (every RSM texel a VPL, no indirect visibility) \
+against the path-traced truth (one bounce with visibility, samples doubled until its own noise is under \
+2%), over the pixels away from geometric and direct-shadow edges (docs/algorithm.md section 6.6). A \
+method's error against the truth cannot fall far below its scene's model error; the truth's noise adds \
+to every error against it in quadrature.\n\n\
+| scene | model error | truth spp | truth noise | pixels left out |\n| --- | ---: | ---: | ---: | ---: |\n"
+        .to_string();
+    for s in &plan.scenes {
+        let Some(r) = o
+            .rows
+            .iter()
+            .find(|r| r.scene == s.name && r.method == "reference")
+        else {
+            continue;
+        };
+        let t = &r.truth;
+        md += &format!(
+            "| {} | {} | {} | {} | {} |\n",
+            s.name,
+            cell(t.rel_rmse_indirect.map(|v| format!("{v:.4}"))),
+            cell(t.spp.map(|v| format!("{v:.0}"))),
+            cell(t.noise.map(|v| format!("{v:.4}"))),
+            cell(t.left_out.map(|v| format!("{:.1}%", 100.0 * v))),
+        );
+    }
+    md
+}
+
 /// The files [`write_all`] writes into the run's folder (checked before a
 /// run begins, with `rows.jsonl` and the gallery's images).
 pub const FILES: &[&str] = &[
@@ -274,6 +311,8 @@ pub const FILES: &[&str] = &[
     "results.csv",
     "speed_vs_error.svg",
     "speed_vs_error.png",
+    "speed_vs_truth.svg",
+    "speed_vs_truth.png",
     "flicker.svg",
     "flicker.png",
     "passes.svg",
@@ -307,6 +346,7 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
     )?;
     crate::output::write_text(&dir.join("results.csv"), &rows::to_csv(&o.rows))?;
     super::charts::speed_vs_error(dir, &o.rows, &scenes)?;
+    super::charts::speed_vs_truth(dir, &o.rows, &scenes)?;
     super::charts::flicker(dir, &o.rows, &scenes)?;
     super::charts::passes(dir, &o.rows, &scenes)?;
     let methods: Vec<&str> = plan.methods.iter().map(|m| m.name()).collect();

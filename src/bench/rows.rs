@@ -47,6 +47,27 @@ pub struct Row {
     /// GPU memory the method's resources take: the allocator's total with the
     /// method's renderer minus that with `--method none`.
     pub gpu_memory_bytes: Option<i64>,
+    /// Against the path-traced truth (docs/algorithm.md section 6.6); empty
+    /// in rows journalled before the bench traced it.
+    #[serde(default)]
+    pub truth: TruthErrors,
+}
+
+/// A row's error against the path-traced truth of the same frames, and (in
+/// the dense reference's row, which the truth is traced beside) what the
+/// truth was.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct TruthErrors {
+    /// Mean over the frames of the indirect image's relative RMSE against
+    /// the truth, over the pixels the truth mask keeps. The reference's is
+    /// the model error every VPL method shares (no indirect visibility).
+    pub rel_rmse_indirect: Option<f64>,
+    /// The truth's samples per pixel, its measured noise (relative RMSE of
+    /// its Monte Carlo noise) and the fraction of pixels with geometry its
+    /// mask leaves out, means over the frames (the reference's row).
+    pub spp: Option<f64>,
+    pub noise: Option<f64>,
+    pub left_out: Option<f64>,
 }
 
 /// What [`read_journal`] found: the rows, and the lines it skipped.
@@ -186,7 +207,7 @@ pub fn to_csv(rows: &[Row]) -> String {
     }
     out += ",width,height,rsm,frames,indirect_ms,indirect_ms_min,total_ms,fragment_invocations,\
 light_patch_evals,rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,\
-gpu_memory_bytes";
+gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out";
     for p in &passes {
         out += &format!(",{p}_ms");
     }
@@ -220,6 +241,10 @@ gpu_memory_bytes";
             opt(&r.flicker_second),
             opt(&r.flicker_final),
             opt(&r.gpu_memory_bytes),
+            opt(&r.truth.rel_rmse_indirect),
+            opt(&r.truth.spp),
+            opt(&r.truth.noise),
+            opt(&r.truth.left_out),
         ]);
         out += &cells.join(",");
         for p in &passes {
@@ -263,6 +288,10 @@ pub(crate) mod tests_support {
             flicker_second: None,
             flicker_final: Some(0.005),
             gpu_memory_bytes: Some(1024),
+            truth: TruthErrors {
+                rel_rmse_indirect: Some(0.12),
+                ..Default::default()
+            },
         }
     }
 }

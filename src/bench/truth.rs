@@ -15,6 +15,7 @@ use crate::readback::Readback;
 use crate::scene::LightKind;
 use crate::view::LightView;
 use glam::{DVec3, Vec2, Vec3};
+use std::path::Path;
 
 /// A kink: the normal's second difference across three pixels in a row
 /// (L1) over this. A second difference, so that a smoothly shaded curved
@@ -234,5 +235,382 @@ pub fn truth_mask(g: &Readback, traced_direct: &[[f32; 4]], shadows: &ShadowMaps
         geometry: geometry.iter().filter(|g| **g).count(),
         geometric_edges,
         shadow_edges,
+    }
+}
+
+/// The path tracer's noise the bench aims under: the relative RMSE of its
+/// indirect image's Monte Carlo noise over the compared pixels (issue 26).
+pub const NOISE_TARGET: f64 = 0.02;
+/// Samples per pixel of each half's first pass, and the most in all.
+const FIRST_SPP: u32 = 16;
+pub const MAX_SPP: u32 = 16384;
+
+/// One frame's path-traced truth: its image (the sum of both halves), the
+/// pixels it is compared on, its samples per pixel and measured noise.
+pub struct Truth {
+    pub image: Readback,
+    pub mask: TruthMask,
+    pub spp: u32,
+    pub noise: f64,
+}
+
+/// Two independent estimates of the indirect image (odd and even seeds),
+/// each a sample-weighted mean; their difference measures the noise of
+/// their mean without knowing the answer.
+struct Halves {
+    a: Readback,
+    b: Readback,
+    spp: u32,
+}
+
+impl Halves {
+    fn add(&mut self, a: Readback, b: Readback, spp: u32) {
+        let (old, new) = (self.spp as f32, spp as f32);
+        let mix = |x: &mut Vec<[f32; 4]>, y: &[[f32; 4]]| {
+            for (p, q) in x.iter_mut().zip(y) {
+                for c in 0..3 {
+                    p[c] = (p[c] * old + q[c] * new) / (old + new);
+                }
+            }
+        };
+        mix(&mut self.a.indirect, &a.indirect);
+        mix(&mut self.b.indirect, &b.indirect);
+        self.spp += spp;
+    }
+
+    /// The relative RMSE noise of the mean of both halves over `mask`:
+    /// each half's per-pixel variance is `s^2 / n`, their difference's
+    /// `2 s^2 / n` and the mean's `s^2 / 2n`, a quarter of the difference's.
+    fn noise(&self, mask: &[bool]) -> f64 {
+        let (mut d, mut m) = (0.0f64, 0.0f64);
+        for k in (0..mask.len()).filter(|&k| mask[k]) {
+            for c in 0..3 {
+                let (x, y) = (self.a.indirect[k][c] as f64, self.b.indirect[k][c] as f64);
+                d += (x - y) * (x - y);
+                m += 0.25 * (x + y) * (x + y);
+            }
+        }
+        if m == 0.0 {
+            0.0
+        } else {
+            0.5 * (d / m).sqrt()
+        }
+    }
+
+    /// Both halves averaged: the image the bench compares with.
+    fn mean(mut self) -> Readback {
+        for (p, q) in self.a.indirect.iter_mut().zip(&self.b.indirect) {
+            for c in 0..3 {
+                p[c] = 0.5 * (p[c] + q[c]);
+            }
+        }
+        for (k, f) in self.a.final_radiance.iter_mut().enumerate() {
+            let (d, e, rho) = (self.a.direct[k], self.a.indirect[k], self.a.albedo[k]);
+            for c in 0..3 {
+                f[c] = d[c] + rho[c] / std::f32::consts::PI * e[c];
+            }
+        }
+        self.a
+    }
+}
+
+/// Path-traces `scene` (posed for the frame) at `g`'s size, doubling up the
+/// samples until the noise of its indirect image over the compared pixels
+/// (`truth_mask` of the rasterised G-buffer `g`) is under `target`, or
+/// [`MAX_SPP`] is reached. `progress(spp, noise)` after each pass.
+pub fn trace(
+    scene: &crate::scene::Scene,
+    g: &Readback,
+    shadows: &ShadowMaps,
+    target: f64,
+    seed: u64,
+    progress: impl Fn(u32, f64),
+) -> Truth {
+    let pass = |spp: u32, s: u64| {
+        crate::pathtrace::render(
+            scene,
+            &crate::pathtrace::PathTraceSettings {
+                width: g.width,
+                height: g.height,
+                spp,
+                seed: s,
+                exposure: 1.0,
+            },
+            |_, _| {},
+        )
+    };
+    // Seeds: the frame's, then two per pass, one per half.
+    let mut next_seed = seed.wrapping_mul(1 << 20);
+    let mut seeds = || {
+        next_seed += 1;
+        next_seed
+    };
+    let mut halves = Halves {
+        a: pass(FIRST_SPP, seeds()),
+        b: pass(FIRST_SPP, seeds()),
+        spp: FIRST_SPP,
+    };
+    let mask = truth_mask(g, &halves.a.direct, shadows);
+    let mut noise = halves.noise(&mask.mask);
+    progress(2 * halves.spp, noise);
+    while noise > target && 2 * halves.spp < MAX_SPP {
+        // Noise falls as 1/sqrt(spp): aim a little past the target.
+        let want = (halves.spp as f64 * (noise / target).powi(2) * 1.2).ceil() as u32;
+        let more = want
+            .min(MAX_SPP / 2)
+            .saturating_sub(halves.spp)
+            .max(FIRST_SPP);
+        let (a, b) = (pass(more, seeds()), pass(more, seeds()));
+        halves.add(a, b, more);
+        noise = halves.noise(&mask.mask);
+        progress(2 * halves.spp, noise);
+    }
+    let spp = 2 * halves.spp;
+    Truth {
+        image: halves.mean(),
+        mask,
+        spp,
+        noise,
+    }
+}
+
+/// What a cached truth records beside its image (`FILE.json`).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CacheNote {
+    width: u32,
+    height: u32,
+    time: f32,
+    target: f64,
+    spp: u32,
+    noise: f64,
+}
+
+/// The layer `name` of the EXR `image` as RGBA pixels (alpha 1).
+fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<Vec<[f32; 4]>> {
+    use exr::prelude::FlatSamples;
+    let layer = image.layer_data.iter().find(|l| {
+        l.attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string())
+            .as_deref()
+            == Some(name)
+    })?;
+    let channel = |c: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.to_string() == c)
+            .and_then(|ch| match &ch.sample_data {
+                FlatSamples::F32(v) if v.len() == pixels => Some(v.clone()),
+                _ => None,
+            })
+    };
+    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
+}
+
+/// A truth traced before for this frame (`path` and its note), if its size,
+/// time and noise target match; anything else is traced again.
+fn cached(path: &Path, g: &Readback, time: f32, target: f64) -> Option<(Readback, u32, f64)> {
+    let note: CacheNote =
+        serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    if (note.width, note.height) != (g.width, g.height)
+        || note.time != time
+        || note.target != target
+    {
+        return None;
+    }
+    let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
+    let n = (g.width * g.height) as usize;
+    let mut r = g.clone();
+    r.direct = layer(&image, "direct", n)?;
+    r.indirect = layer(&image, "indirect", n)?;
+    r.final_radiance = layer(&image, "final", n)?;
+    Some((r, note.spp, note.noise))
+}
+
+/// Which truth of a scene a bench frame needs: its animation time, the
+/// noise target, and the seed of its first samples.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameKey {
+    pub time: f32,
+    pub target: f64,
+    pub seed: u64,
+}
+
+/// The truth of one bench frame: read from `path` when traced before for
+/// the same size, time and noise target, else traced (see [`trace`]) and written
+/// there (an EXR of the path tracer's layers and a JSON note), so that a
+/// run that stops resumes without tracing it again.
+pub fn frame_truth(
+    path: &Path,
+    posed: &crate::scene::Scene,
+    g: &Readback,
+    shadows: &ShadowMaps,
+    key: FrameKey,
+    progress: impl Fn(u32, f64),
+) -> anyhow::Result<Truth> {
+    let FrameKey { time, target, seed } = key;
+    if let Some((image, spp, noise)) = cached(path, g, time, target) {
+        let mask = truth_mask(g, &image.direct, shadows);
+        return Ok(Truth {
+            image,
+            mask,
+            spp,
+            noise,
+        });
+    }
+    let truth = trace(posed, g, shadows, target, seed, progress);
+    crate::output::write_exr(path, &truth.image)?;
+    let note = CacheNote {
+        width: g.width,
+        height: g.height,
+        time,
+        target,
+        spp: truth.spp,
+        noise: truth.noise,
+    };
+    crate::output::write_text(
+        &path.with_extension("json"),
+        &serde_json::to_string_pretty(&note)?,
+    )?;
+    Ok(truth)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::readback::RsmReadback;
+    use glam::Mat4;
+
+    const W: u32 = 64;
+
+    /// A floor seen from above, 0.25 m a pixel: x from -8 to 8 m, depth 10
+    /// m, normal up; a step up (a ledge, depth 9 m) from column 48 on.
+    fn floor() -> Readback {
+        let n = (W * W) as usize;
+        let mut position = vec![[0.0; 4]; n];
+        let mut normal = vec![[0.0, 1.0, 0.0, 0.0]; n];
+        for k in 0..n {
+            let (x, y) = ((k as u32 % W) as f32, (k as u32 / W) as f32);
+            let ledge = x >= 48.0;
+            position[k] = [
+                -8.0 + 0.25 * (x + 0.5),
+                if ledge { 1.0 } else { 0.0 },
+                -8.0 + 0.25 * (y + 0.5),
+                if ledge { 9.0 } else { 10.0 },
+            ];
+            normal[k][3] = 0.0;
+        }
+        let empty = vec![[0.0; 4]; n];
+        Readback {
+            width: W,
+            height: W,
+            final_radiance: empty.clone(),
+            direct: empty.clone(),
+            indirect: empty.clone(),
+            albedo: empty,
+            normal,
+            position,
+            display: vec![],
+            rsm: RsmReadback {
+                resolution: 0,
+                position: vec![],
+                normal: vec![],
+                flux: vec![],
+            },
+        }
+    }
+
+    /// A sun straight down whose RSM of `r` texels spans the floor's 16 m.
+    fn sun_view() -> LightView {
+        // World x, z in [-8, 8] to clip [-1, 1]; depth unused here.
+        let view_proj = Mat4::from_cols_array(&[
+            1.0 / 8.0,
+            0.0,
+            0.0,
+            0.0, //
+            0.0,
+            0.0,
+            0.01,
+            0.0, //
+            0.0,
+            1.0 / 8.0,
+            0.0,
+            0.0, //
+            0.0,
+            0.0,
+            0.5,
+            1.0,
+        ]);
+        LightView {
+            light: 0,
+            kind: LightKind::Directional,
+            face: None,
+            view_proj,
+            position: Vec3::ZERO,
+            direction: -Vec3::Y,
+            half_extent: 8.0,
+            depth_range: 10.0,
+            cube: [Mat4::ZERO; 6],
+        }
+    }
+
+    /// Exact direct light: lit left of column 24, shadowed right of it.
+    fn shadowed_right() -> Vec<[f32; 4]> {
+        (0..W * W)
+            .map(|k| if k % W < 24 { [1.0; 4] } else { [0.0; 4] })
+            .collect()
+    }
+
+    /// The columns of row 32 the mask keeps.
+    fn kept_columns(r: u32) -> Vec<u32> {
+        let views = [sun_view()];
+        let shadows = ShadowMaps::new(&views, DVec3::ZERO, r, 1.0);
+        let m = truth_mask(&floor(), &shadowed_right(), &shadows);
+        (0..W).filter(|&x| m.mask[(32 * W + x) as usize]).collect()
+    }
+
+    #[test]
+    fn geometric_edges_are_left_out_grown_by_a_pixel_and_shadow_edges_by_pcf_texels() {
+        // RSM 64: a texel is a pixel (0.25 m), the band 2.5 texels; RSM 16:
+        // a texel is 4 pixels, the band 10 pixels.
+        for (r, band) in [(64, 2.5f32), (16, 10.0)] {
+            let kept = kept_columns(r);
+            for x in 0..W {
+                // Pixel centres against the shadow edge at x = 24 (between
+                // columns 23 and 24, measured from the edge pixels' centres).
+                let from_edge = if x < 24 { 23 - x } else { x - 24 } as f32;
+                let near_shadow = from_edge <= band;
+                let near_step = (46..=49).contains(&x);
+                assert_eq!(
+                    kept.contains(&x),
+                    !near_shadow && !near_step,
+                    "RSM {r}: column {x} (kept: {kept:?})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_smoothly_curved_surface_is_not_an_edge() {
+        // A cylinder along z seen from above: the normal turns 3 degrees a
+        // pixel, as a column's does, but has no kink.
+        let mut g = floor();
+        for k in 0..(W * W) as usize {
+            let a = ((k as u32 % W) as f32 - 32.0) * 3f32.to_radians();
+            g.normal[k] = [a.sin(), a.cos(), 0.0, 0.0];
+            g.position[k][1] = 0.0;
+            g.position[k][3] = 10.0;
+        }
+        let views = [sun_view()];
+        let shadows = ShadowMaps::new(&views, DVec3::ZERO, 64, 1.0);
+        let lit = vec![[1.0; 4]; (W * W) as usize];
+        let m = truth_mask(&g, &lit, &shadows);
+        assert_eq!(m.geometric_edges, 0);
+        assert_eq!(m.shadow_edges, 0);
+        assert_eq!(m.left_out(), 0.0);
     }
 }

@@ -309,13 +309,7 @@ fn render(args: RenderArgs) -> Result<()> {
         }
         // The CPU reference renders the scene posed at --time.
         let state = args.state_at(&scene, run.time)?;
-        let mut posed = scene.clone();
-        posed.camera = state.camera;
-        posed.lights = state.lights;
-        for (inst, m) in posed.instances.iter_mut().zip(&state.instance_transforms) {
-            inst.world_from_object = *m;
-        }
-        return pathtrace(&args, &posed);
+        return pathtrace(&args, &state.pose(&scene));
     };
     if scene
         .lights

@@ -339,6 +339,18 @@ impl FrameState {
                 .collect(),
         }
     }
+
+    /// `scene` posed in this state: its camera, lights and instance
+    /// transforms replaced (what the CPU path tracer renders a frame from).
+    pub fn pose(&self, scene: &Scene) -> Scene {
+        let mut posed = scene.clone();
+        posed.camera = self.camera;
+        posed.lights = self.lights.clone();
+        for (inst, m) in posed.instances.iter_mut().zip(&self.instance_transforms) {
+            inst.world_from_object = *m;
+        }
+        posed
+    }
 }
 
 #[derive(Clone, Debug)]
