@@ -831,6 +831,19 @@ fn frame_truth(
         ))
     };
     message(0, f64::NAN);
-    truth::frame_truth(&path, posed, g, &shadows, key, message)
-        .with_context(|| format!("the path-traced truth of {} frame {k}", spec.name))
+    let t = truth::frame_truth(&path, posed, g, &shadows, key, message)
+        .with_context(|| format!("the path-traced truth of {} frame {k}", spec.name))?;
+    if bar.is_hidden() {
+        // No terminal (a log, CI): a line per frame, as per row.
+        eprintln!(
+            "{}: path-traced truth of frame {}/{}: {} spp, noise {:.4}, {:.1}% of pixels left out",
+            spec.name,
+            k + 1,
+            plan.frames,
+            t.spp,
+            t.noise,
+            100.0 * t.mask.left_out()
+        );
+    }
+    Ok(t)
 }
