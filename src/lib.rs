@@ -26,4 +26,5 @@ pub mod settings;
 pub mod soak;
 pub mod view;
 pub mod viewer;
+pub mod visibility;
 pub mod vk;

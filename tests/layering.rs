@@ -17,7 +17,7 @@ const LAYERS: &[&[&str]] = &[
     &["methods", "readback"],
     &["debug_view", "output"],
     &["renderer", "pathtrace"],
-    &["report", "soak"],
+    &["report", "soak", "visibility"],
     &["viewer", "bench"],
     &["cli"],
 ];

@@ -322,6 +322,11 @@ fn render(args: RenderArgs) -> Result<()> {
     // The settings' own checks need no device: they fail before it starts.
     crate::frame::check::check_ranges(&settings)?;
     crate::methods::check(&settings)?;
+    let exact = crate::methods::reference::VISIBILITY.get(&settings)
+        == crate::methods::reference::Visibility::Exact;
+    if exact && args.sequence.is_some() {
+        bail!("--visibility exact renders one frame (it is the CPU limit, minutes a frame); drop --sequence");
+    }
     let gpu = Gpu::new(&run.gpu_options())?;
     if !gpu.features.sampled_image_array_indexing {
         if let Some(w) = scene::one_texture::keep_one(&mut scene) {
@@ -342,7 +347,8 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(dir) = &args.sequence {
         return sequence(&args, &scene, &gpu, &mut renderer, dir);
     }
-    renderer.update(&args.state_at(&scene, run.time)?)?;
+    let state = args.state_at(&scene, run.time)?;
+    renderer.update(&state)?;
     let frames = args.frames;
     let mut bar: Option<indicatif::ProgressBar> = None;
     let mut finished = 0;
@@ -378,7 +384,20 @@ fn render(args: RenderArgs) -> Result<()> {
         bar.finish_and_clear();
     }
     let stats = stats?;
-    let result = renderer.readback()?;
+    let mut result = renderer.readback()?;
+    if exact {
+        // The indirect layer again on the CPU, each VPL tested for each pixel.
+        let bar = crate::progress::bar(result.height as u64, "rows");
+        bar.set_message("exact visibility");
+        result = crate::visibility::with_exact_visibility(
+            &mut renderer,
+            &state.pose(&scene),
+            result,
+            run.exposure,
+            |done, _| bar.set_position(done as u64),
+        )?;
+        bar.finish_and_clear();
+    }
     // For --stats, the debug views and the timings JSON's light-patch numbers.
     let multires = renderer.readback_multires()?;
     let light_stats = match &multires {

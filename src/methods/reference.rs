@@ -22,7 +22,7 @@ use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
-use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Method, RenderSettings};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
@@ -42,7 +42,44 @@ pub const CHUNK: Param<u64> = Param {
     range: Range::at_least(1.0),
 };
 
-const PARAMS: &[&dyn AnyParam] = &[&CHUNK];
+/// Which VPLs see which receivers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// Every VPL sees every receiver it faces (the talk's model).
+    None,
+    /// One ray per receiver and VPL, on the CPU.
+    Exact,
+}
+
+impl Choices for Visibility {
+    const NAMES: &'static [(&'static str, &'static str)] = &[
+        (
+            "none",
+            "every VPL lights every receiver it faces, occluded or not (the talk's model)",
+        ),
+        (
+            "exact",
+            "a ray from each receiver to each VPL through the scene's BVH, on the CPU \
+             (slow: the limit the model can reach)",
+        ),
+    ];
+    fn index(self) -> usize {
+        self as usize
+    }
+    fn from_index(i: usize) -> Self {
+        [Visibility::None, Visibility::Exact][i]
+    }
+}
+
+pub const VISIBILITY: Param<Visibility> = Param {
+    name: "visibility",
+    help: "--method reference: whether VPLs are occluded on their way to a receiver \
+           (exact: the CPU limit, minutes at 256x256)",
+    default: DefaultValue::Fixed(Visibility::None),
+    range: Range::ANY,
+};
+
+const PARAMS: &[&dyn AnyParam] = &[&CHUNK, &VISIBILITY];
 
 pub struct ReferenceMethod;
 

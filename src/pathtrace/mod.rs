@@ -43,6 +43,46 @@ fn ray_offset(p: Vec3A) -> f32 {
     (p.abs().max_element() * 2e-6).max(f32::MIN_POSITIVE * 1e6)
 }
 
+/// The scene's surfaces as occluders between two surface points, with the
+/// path tracer's BVH and its rules: what blocks a bounce ray blocks the
+/// segment (back faces of single-sided surfaces do not), and positions are
+/// taken relative to the camera as the path tracer's are (issue 25:
+/// `visibility` tests VPL-to-receiver visibility with it).
+pub struct Occluders<'a> {
+    shading: Shading<'a>,
+}
+
+impl<'a> Occluders<'a> {
+    /// `scene` as posed for the frame.
+    pub fn new(scene: &'a Scene) -> Self {
+        Occluders {
+            shading: Shading::new(scene),
+        }
+    }
+
+    /// Whether the surface point `to` (world space) is seen from the
+    /// surface point `from` with normal `n_from`: no surface lies between
+    /// them, the ray leaving `from` just off its surface and stopping just
+    /// short of `to` (each by the offset of its coordinates' rounding).
+    pub fn visible(&self, from: Vec3, n_from: Vec3, to: Vec3) -> bool {
+        let origin = self.shading.origin;
+        let rel = |p: Vec3| Vec3A::from((p.as_dvec3() - origin).as_vec3());
+        let (a, b) = (rel(from), rel(to));
+        let offset = ray_offset(a);
+        let start = a + Vec3A::from(n_from) * offset;
+        let v = b - start;
+        let d = v.length();
+        let end = d - 2.0 * ray_offset(b) - 1e-4 * d;
+        if !(d > 0.0 && end > offset) {
+            return true;
+        }
+        self.shading
+            .bvh
+            .intersect(start, v / d, offset, end, true, Cull::BackFaces)
+            .is_none()
+    }
+}
+
 /// A small, fast generator (PCG32) seeded per pixel, so results do not depend
 /// on the thread schedule.
 struct Pcg(u64);
