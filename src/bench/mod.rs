@@ -540,7 +540,16 @@ fn run_scene(
             ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
             let out = r.readback()?;
             let truth = if with_truth {
-                let t = frame_truth(plan, spec, k, &state.pose(scene), &r, &out, bar)?;
+                let posed = state.pose(scene);
+                let t = frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
+                if k == plan.frames / 2 {
+                    let exact = model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
+                    model.floor = Some(metrics::relative_rmse(
+                        &exact,
+                        &t.image.indirect,
+                        &t.mask.mask,
+                    ));
+                }
                 let n = plan.frames as f64;
                 let e = metrics::relative_rmse(&out.indirect, &t.image.indirect, &t.mask.mask);
                 let add = |v: &mut Option<f64>, x: f64| *v = Some(v.unwrap_or(0.0) + x / n);
@@ -790,6 +799,47 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         gpu_memory_bytes: None,
         truth: Default::default(),
     }
+}
+
+/// The dense reference's indirect image of frame `k` of `spec` with exact
+/// visibility (`visibility::with_exact_visibility`; `out` is the frame `r`
+/// rendered), cached beside the truth (`truth/SCENE/exact-K.exr`) as it
+/// takes minutes on a CPU.
+fn model_floor(
+    plan: &Plan,
+    spec: &SceneSpec,
+    k: u32,
+    posed: &Scene,
+    r: &mut Renderer,
+    out: &Readback,
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<[f32; 4]>> {
+    let path = plan
+        .out_dir
+        .join("truth")
+        .join(&spec.name)
+        .join(format!("exact-{k}.exr"));
+    let time = frame_time(spec, k);
+    if let Some(cached) = truth::cached_exact(&path, out, time, plan.base.rsm_resolution) {
+        return Ok(cached);
+    }
+    let message = |done: usize, rows: usize| {
+        bar.set_message(format!(
+            "{}: the reference with exact visibility, frame {}: row {done}/{rows}",
+            spec.name,
+            k + 1
+        ))
+    };
+    let exact = crate::visibility::with_exact_visibility(r, posed, out.clone(), 1.0, message)?;
+    truth::write_exact(&path, &exact, time, plan.base.rsm_resolution)?;
+    if bar.is_hidden() {
+        eprintln!(
+            "{}: the reference with exact visibility at frame {}",
+            spec.name,
+            k + 1
+        );
+    }
+    Ok(exact.indirect)
 }
 
 /// The path-traced truth of frame `k` of `spec` at the run's noise target,

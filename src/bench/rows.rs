@@ -68,6 +68,11 @@ pub struct TruthErrors {
     pub spp: Option<f64>,
     pub noise: Option<f64>,
     pub left_out: Option<f64>,
+    /// The reference's row: the dense reference with exact visibility
+    /// (`visibility`) against the truth at the middle frame, the floor of
+    /// the VPL model (its texel-sized VPLs alone).
+    #[serde(default)]
+    pub floor: Option<f64>,
 }
 
 /// What [`read_journal`] found: the rows, and the lines it skipped.
@@ -207,7 +212,7 @@ pub fn to_csv(rows: &[Row]) -> String {
     }
     out += ",width,height,rsm,frames,indirect_ms,indirect_ms_min,total_ms,fragment_invocations,\
 light_patch_evals,rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,\
-gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out";
+gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out,truth_floor";
     for p in &passes {
         out += &format!(",{p}_ms");
     }
@@ -245,6 +250,7 @@ gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out";
             opt(&r.truth.spp),
             opt(&r.truth.noise),
             opt(&r.truth.left_out),
+            opt(&r.truth.floor),
         ]);
         out += &cells.join(",");
         for p in &passes {

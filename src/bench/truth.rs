@@ -479,6 +479,42 @@ pub fn frame_truth(
     Ok(truth)
 }
 
+/// What a cached exact-visibility reference records beside its image.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ExactNote {
+    width: u32,
+    height: u32,
+    time: f32,
+    rsm: u32,
+}
+
+/// The indirect image of an exact-visibility reference written before for
+/// this frame (`path` and its note), if its size, time and RSM match.
+pub fn cached_exact(path: &Path, g: &Readback, time: f32, rsm: u32) -> Option<Vec<[f32; 4]>> {
+    let note: ExactNote =
+        serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    if (note.width, note.height, note.rsm) != (g.width, g.height, rsm) || note.time != time {
+        return None;
+    }
+    let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
+    layer(&image, "indirect", (g.width * g.height) as usize)
+}
+
+/// Writes an exact-visibility reference frame for [`cached_exact`].
+pub fn write_exact(path: &Path, r: &Readback, time: f32, rsm: u32) -> anyhow::Result<()> {
+    crate::output::write_exr(path, r)?;
+    let note = ExactNote {
+        width: r.width,
+        height: r.height,
+        time,
+        rsm,
+    };
+    crate::output::write_text(
+        &path.with_extension("json"),
+        &serde_json::to_string_pretty(&note)?,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
