@@ -411,14 +411,16 @@ fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<V
     Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
 }
 
-/// A truth traced before for this frame (`path` and its note), if its size,
-/// time and noise target match; anything else is traced again.
+/// A truth traced before for this frame (`path` and its note), if its size
+/// and time match and it was traced for this noise target or measured under
+/// it; anything else is traced again.
 fn cached(path: &Path, g: &Readback, time: f32, target: f64) -> Option<(Readback, u32, f64)> {
     let note: CacheNote =
         serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    // A truth traced for a tighter target serves a looser one as it is.
     if (note.width, note.height) != (g.width, g.height)
         || note.time != time
-        || note.target != target
+        || !(note.target == target || note.noise <= target)
     {
         return None;
     }
@@ -441,7 +443,7 @@ pub struct FrameKey {
 }
 
 /// The truth of one bench frame: read from `path` when traced before for
-/// the same size, time and noise target, else traced (see [`trace`]) and written
+/// the same size and time, to this noise target or under it, else traced (see [`trace`]) and written
 /// there (an EXR of the path tracer's layers and a JSON note), so that a
 /// run that stops resumes without tracing it again.
 pub fn frame_truth(
