@@ -10,17 +10,28 @@
 int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
 
 // The node's squared reach: patch j splits for receiver i iff
-// |V_ij|^2 <= reach (gather.frag has the derivation; the per-level factor
-// 4^k, k its levels above the finest RSM texel). Invalid patches are held to
-// tau * HISR_INVALID_TAU_SCALE. Nodes at the max depth, and empty ones, never
-// split: -1. light-tree-pack stores it in the packed node's flux.a, so the
-// traversal and the tile cut test a node with one comparison and decide
-// exactly alike.
+// |V_ij|^2 <= reach. Invalid patches are held to tau * HISR_INVALID_TAU_SCALE.
+// Nodes at the max depth, and empty ones, never split: -1. light-tree-pack
+// stores it in the packed node's flux.a, so the traversal and the tile cut
+// test a node with one comparison and decide exactly alike.
+//
+// Relative tau (docs/algorithm.md section 4.3): split while the patch's solid
+// angle seen from the receiver, as the disc form factor A_j / (pi |V_ij|^2 +
+// A_j) of section 2.6, exceeds tau:
+//   A_j / (pi |V_ij|^2 + A_j) > tau  iff  |V_ij|^2 < A_j (1 - tau) / (pi tau).
+// The patch's own summed area A_j: no per-level factor and no light type.
+// Absolute tau (the talk): gather.frag has the derivation; the per-level
+// factor 4^k, k the node's levels above the finest RSM texel.
 float hisr_reach(LightPatch lp, ivec3 node) {
     if (node.z >= run.hisr_max_depth || lp.position_area.w <= 0.0) return -1.0;
+    bool invalid = lp.normal.w == PATCH_INVALID;
+    if (run.hisr_tau_mode == HISR_TAU_RELATIVE) {
+        float tau = run.hisr_tau * (invalid ? HISR_INVALID_TAU_SCALE : 1.0);
+        return lp.position_area.w * (1.0 - tau) / (PI * tau);
+    }
     int mip = run.rsm_top_level - node.z;
     float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.hisr_threshold);
-    if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
+    if (invalid) reach /= HISR_INVALID_TAU_SCALE;
     return reach;
 }
 

@@ -75,9 +75,15 @@ struct RunUniforms {
     int hisr_max_depth;           // and subdivides down to 2^d x 2^d
     // Restricted splats.
     float splat_threshold;        // irradiance bound, W/m^2
-    int pad0;
-    int pad1;
+    // HISR's tau and what it is relative to (docs/algorithm.md section 4.3;
+    // hisr_reach in hisr.glsl).
+    float hisr_tau;               // --tau
+    int hisr_tau_mode;            // HISR_TAU_*
 };
+
+// RunUniforms::hisr_tau_mode: what HISR's tau bounds (docs/algorithm.md 4.3).
+const int HISR_TAU_RELATIVE = 0;  // each evaluated patch's solid angle seen from the receiver
+const int HISR_TAU_ABSOLUTE = 1;  // the talk's: its bound over the light's peak intensity
 
 // Where one mesh instance is this frame (std430, set 0 binding 2, one per
 // `Scene::instances` entry, one buffer per frame in flight).

@@ -79,9 +79,14 @@ pub struct RunUniforms {
     pub hisr_max_depth: i32,
     /// Restricted splats (`methods::rsm_splat`).
     pub splat_threshold: f32,
-    pub pad0: i32,
-    pub pad1: i32,
+    /// HISR's tau and `HISR_TAU_*` (`methods::hisr`).
+    pub hisr_tau: f32,
+    pub hisr_tau_mode: i32,
 }
+
+/// `RunUniforms::hisr_tau_mode` values, as in `shaders/shared.glsl`.
+pub const HISR_TAU_RELATIVE: i32 = 0;
+pub const HISR_TAU_ABSOLUTE: i32 = 1;
 
 /// `InstanceTransform` (std430): where one mesh instance is this frame.
 #[repr(C)]

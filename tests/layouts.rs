@@ -122,7 +122,7 @@ fn frame_uniforms_match_shared_glsl() {
 #[test]
 fn run_uniforms_match_shared_glsl() {
     for shader in ["direct_light.frag", "gather.frag", "upsample.comp"] {
-        check!(shader, RunUniforms, "RunUniforms", pad1: 4, [
+        check!(shader, RunUniforms, "RunUniforms", hisr_tau_mode: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
             pcf_radius => "pcf_radius",
@@ -144,8 +144,8 @@ fn run_uniforms_match_shared_glsl() {
             hisr_start_depth => "hisr_start_depth",
             hisr_max_depth => "hisr_max_depth",
             splat_threshold => "splat_threshold",
-            pad0 => "pad0",
-            pad1 => "pad1",
+            hisr_tau => "hisr_tau",
+            hisr_tau_mode => "hisr_tau_mode",
         ]);
     }
 }
@@ -249,6 +249,8 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("LIGHT_SPOT"), LIGHT_SPOT as u32);
     assert_eq!(value("HISR_CUT_OVERFLOW"), HISR_CUT_OVERFLOW);
     assert_eq!(value("HISR_CUT_LEVELS"), HISR_CUT_LEVELS as u32);
+    assert_eq!(value("HISR_TAU_RELATIVE"), HISR_TAU_RELATIVE as u32);
+    assert_eq!(value("HISR_TAU_ABSOLUTE"), HISR_TAU_ABSOLUTE as u32);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
     assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {

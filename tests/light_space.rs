@@ -19,12 +19,13 @@ fn settings(method: Method, rsm: u32) -> RenderSettings {
 }
 
 /// HISR against the dense gather of every RSM texel (the converged limit of
-/// the light-space choice), as tau falls, for each kind of light: the error
+/// the light-space choice), as tau falls, for each kind of light and both
+/// meanings of tau (`--hisr-tau-mode`): the error
 /// falls at every step, more light patches are evaluated per eye-space patch
 /// at every step, the coarsest tau is visibly approximate and the finest
 /// matches. The spot lights the built-in box; the point and directional
 /// lights the still box, with RSMs (six faces for the point light) of 32.
-fn hisr_converges(kind: LightKind) {
+fn hisr_converges(kind: LightKind, mode: hisr::TauMode) {
     let gpu = gpu();
     let (scene, rsm, size, taus): (_, u32, u32, &[f32]) = match kind {
         LightKind::Spot => (
@@ -60,13 +61,14 @@ fn hisr_converges(kind: LightKind) {
     for &tau in taus {
         let s = at(hisr::KEY)
             .with(&hisr::TAU, tau)
+            .with(&hisr::TAU_MODE, mode)
             // log2 of the RSM: down to single texels.
             .with(&hisr::MAX_DEPTH, rsm.ilog2());
         let out = render_multires(&gpu, &scene, &s);
         errors.push(indirect_rmse(&out.readback, &dense.readback));
         evaluations.push(isr::debug_view::light_patch_stats(&out.multires, None).per_patch_mean);
     }
-    println!("{kind:?}: tau {taus:?}: relative RMSE {errors:?}, light patches per eye patch {evaluations:?}");
+    println!("{kind:?}, {mode:?}: tau {taus:?}: relative RMSE {errors:?}, light patches per eye patch {evaluations:?}");
     for w in errors.windows(2) {
         assert!(
             w[1] <= w[0],
@@ -89,10 +91,23 @@ fn hisr_converges(kind: LightKind) {
     );
 }
 
-light_kind_tests!(hisr_converges:
+fn hisr_relative_converges(kind: LightKind) {
+    hisr_converges(kind, hisr::TauMode::Relative);
+}
+
+fn hisr_absolute_converges(kind: LightKind) {
+    hisr_converges(kind, hisr::TauMode::Absolute);
+}
+
+light_kind_tests!(hisr_relative_converges:
     hisr_converges_to_the_dense_gather_for_a_spot_light,
     hisr_converges_to_the_dense_gather_for_a_point_light,
     hisr_converges_to_the_dense_gather_for_a_directional_light);
+
+light_kind_tests!(hisr_absolute_converges:
+    hisr_with_absolute_tau_converges_for_a_spot_light,
+    hisr_with_absolute_tau_converges_for_a_point_light,
+    hisr_with_absolute_tau_converges_for_a_directional_light);
 
 #[test]
 fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
@@ -278,16 +293,25 @@ fn stats_and_vpl_count_view_from_the_cli() {
 /// HISR traverses the quadtree packed into one buffer: node (x, y) of depth d
 /// at (4^d - 1) / 3 + y 2^d + x holds exactly the quadtree texel of mip
 /// log2 R - d (position and area, normal and state, flux), and in flux.a its
-/// squared reach (`hisr_reach`): for the spot light 4^k T |p - light|^2, k its
-/// levels above the finest, divided by HISR_INVALID_TAU_SCALE for invalid
-/// patches; -1 at the max depth and for empty nodes. Depths below the max
-/// depth are never read, and not packed.
+/// squared reach (`hisr_reach`): with relative tau A (1 - tau) / (pi tau), A
+/// its area; with absolute tau (the spot light) 4^k T |p - light|^2, k its
+/// levels above the finest; invalid patches with tau times
+/// HISR_INVALID_TAU_SCALE; -1 at the max depth and for empty nodes. Depths
+/// below the max depth are never read, and not packed.
 #[test]
 fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
+    for mode in [hisr::TauMode::Relative, hisr::TauMode::Absolute] {
+        packed_tree_matches(mode);
+    }
+}
+
+fn packed_tree_matches(mode: hisr::TauMode) {
     let gpu = gpu();
     let rsm = 32u32;
     let scene = cornell_box();
-    let s = settings(hisr::KEY, rsm).with(&hisr::MAX_DEPTH, 4);
+    let s = settings(hisr::KEY, rsm)
+        .with(&hisr::MAX_DEPTH, 4)
+        .with(&hisr::TAU_MODE, mode);
     let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
     let packed = r.hisr_packed_tree().unwrap().expect("hisr packs its tree");
@@ -318,16 +342,24 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
                 let p = glam::DVec3::new(pos[i][0] as f64, pos[i][1] as f64, pos[i][2] as f64);
                 let scale = if nrm[i][3] == PATCH_INVALID {
                     invalid += 1;
-                    1.0 / HISR_INVALID_TAU_SCALE as f64
+                    HISR_INVALID_TAU_SCALE as f64
                 } else {
                     1.0
                 };
-                4f64.powi((top - d) as i32) * t * (p - light).length_squared() * scale
+                match mode {
+                    hisr::TauMode::Relative => {
+                        let tau = hisr::TAU.get(&s) as f64 * scale;
+                        pos[i][3] as f64 * (1.0 - tau) / (std::f64::consts::PI * tau)
+                    }
+                    hisr::TauMode::Absolute => {
+                        4f64.powi((top - d) as i32) * t * (p - light).length_squared() / scale
+                    }
+                }
             };
             let got = n.flux[3] as f64;
             assert!(
                 (got - reach).abs() <= 1e-5 * reach.abs(),
-                "depth {d} node {i}: reach {got}, expected {reach}"
+                "{mode:?}: depth {d} node {i}: reach {got}, expected {reach}"
             );
             lit += (pos[i][3] > 0.0) as usize;
         }
@@ -347,18 +379,29 @@ fn the_packed_light_tree_is_the_rsm_quadtree_node_for_node() {
 /// a spot, a point light (six cube faces) with a directional one, partial
 /// tiles (80x48 is no multiple of 16), patches coarser than the tile (K = 1),
 /// and tiles whose cut overflows (tau so small that every node splits down
-/// to the 4096 leaves, more than a tile's entries).
+/// to the 4096 leaves, more than a tile's entries), with relative and
+/// absolute tau.
 #[test]
 fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
     let gpu = gpu();
     let two_lights = cornell_with(vec![box_point(), box_sun()]);
+    use hisr::TauMode::{Absolute, Relative};
     let cases = [
-        ("spot", cornell_box(), 0.05, 4),
-        ("spot, coarse patches", cornell_box(), 0.05, 1),
-        ("spot, tiny tau", cornell_box(), 1e-5, 4),
-        ("point + directional", two_lights, 0.05, 3),
+        ("spot", cornell_box(), 0.05, 4, Relative),
+        ("spot, coarse patches", cornell_box(), 0.05, 1, Relative),
+        ("spot, tiny tau", cornell_box(), 1e-5, 4, Relative),
+        ("point + directional", two_lights.clone(), 0.05, 3, Relative),
+        ("spot, absolute tau", cornell_box(), 0.05, 4, Absolute),
+        ("spot, absolute tiny tau", cornell_box(), 1e-5, 4, Absolute),
+        (
+            "point + directional, absolute tau",
+            two_lights,
+            0.05,
+            3,
+            Absolute,
+        ),
     ];
-    for (label, scene, tau, tile_level) in cases {
+    for (label, scene, tau, tile_level, mode) in cases {
         let with = |k| {
             RenderSettings {
                 width: 80,
@@ -368,6 +411,7 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
                 ..Default::default()
             }
             .with(&hisr::TAU, tau)
+            .with(&hisr::TAU_MODE, mode)
             .with(&hisr::TILE_LEVEL, k)
             // Levels 0-4: with K = 1 the cut levels' tiles are 2, 4 and 8
             // pixels a side, and level 4's patches are coarser than all.

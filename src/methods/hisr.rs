@@ -12,10 +12,12 @@ use super::multires_method::{
 };
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::{HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS};
+use crate::gpu_types::{
+    HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS, HISR_TAU_ABSOLUTE, HISR_TAU_RELATIVE,
+};
 use crate::multires;
 use crate::passes::{rsm_tree, ComputePass, INDIRECT_COMPUTE};
-use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::barrier;
 use crate::vk::pipeline::Binding;
@@ -54,10 +56,54 @@ pub const MAX_DEPTH: Param<u32> = Param {
 
 pub const TAU: Param<f32> = Param {
     name: "tau",
-    help: "HISR's error threshold, as a fraction of the light's peak intensity: a light \
-           patch is subdivided while its contribution could exceed tau * I",
+    help: "HISR's error threshold: a light patch is subdivided while its solid angle seen \
+           from the receiver exceeds tau (--hisr-tau-mode relative), or while its contribution \
+           could exceed tau * I (absolute)",
     default: DefaultValue::Fixed(0.05),
     range: Range::open(0.0, 1.0),
+};
+
+/// What `--tau` bounds (docs/algorithm.md section 4.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TauMode {
+    /// A light patch splits while its solid angle seen from the receiver,
+    /// `A_j / (pi |V_ij|^2 + A_j)`, exceeds tau: each evaluated patch then
+    /// errs by a small fraction of its own contribution, so a receiver errs
+    /// by about that fraction of its total indirect irradiance.
+    Relative,
+    /// The talk's test: while its bound exceeds tau times the light's peak
+    /// intensity over the squared distance to the patch.
+    Absolute,
+}
+
+impl Choices for TauMode {
+    const NAMES: &'static [(&'static str, &'static str)] = &[
+        (
+            "relative",
+            "split while a light patch's solid angle seen from the receiver exceeds tau \
+             (the error is a like fraction of the indirect light on any scene)",
+        ),
+        (
+            "absolute",
+            "the talk's test: split while a light patch's bound exceeds tau times the light's \
+             peak intensity over the squared distance to the patch",
+        ),
+    ];
+    fn index(self) -> usize {
+        self as usize
+    }
+    fn from_index(i: usize) -> Self {
+        [TauMode::Relative, TauMode::Absolute][i]
+    }
+}
+
+pub const TAU_MODE: Param<TauMode> = Param {
+    name: "hisr-tau-mode",
+    help: "What HISR's --tau bounds: each evaluated light patch's solid angle seen from the \
+           receiver (relative), or its contribution as a fraction of the light's peak \
+           intensity (absolute, the talk's form)",
+    default: DefaultValue::Fixed(TauMode::Relative),
+    range: Range::ANY,
 };
 
 pub const TILE_LEVEL: Param<u32> = Param {
@@ -69,7 +115,7 @@ pub const TILE_LEVEL: Param<u32> = Param {
     range: Range::closed(0.0, MAX_TILE_LEVEL as f64),
 };
 
-pub const PARAMS: &[&dyn AnyParam] = &[&TAU, &START_LEVEL, &MAX_DEPTH, &TILE_LEVEL];
+pub const PARAMS: &[&dyn AnyParam] = &[&TAU, &TAU_MODE, &START_LEVEL, &MAX_DEPTH, &TILE_LEVEL];
 
 /// T at the finest level for `tau` given as a fraction of the light's peak
 /// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2)
@@ -115,6 +161,11 @@ impl Descriptor for HisrMethod {
     }
     fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
         u.hisr_threshold = subdivision_threshold(TAU.get(s), s.rsm_resolution);
+        u.hisr_tau = TAU.get(s);
+        u.hisr_tau_mode = match TAU_MODE.get(s) {
+            TauMode::Relative => HISR_TAU_RELATIVE,
+            TauMode::Absolute => HISR_TAU_ABSOLUTE,
+        };
         u.hisr_start_depth = START_LEVEL.get(s) as i32;
         u.hisr_max_depth = MAX_DEPTH.get(s) as i32;
     }
@@ -123,6 +174,9 @@ impl Descriptor for HisrMethod {
     }
     fn label(&self, s: &RenderSettings) -> String {
         let mut l = format!("tau {}, depth {}", TAU.get(s), MAX_DEPTH.get(s));
+        if TAU_MODE.get(s) == TauMode::Absolute {
+            l += ", absolute";
+        }
         let eye = multires::DEPTH_THRESHOLD.get(s);
         if eye != multires::DEPTH_THRESHOLD.default_in(s) {
             l += &format!(", eye depth {eye}");
@@ -134,20 +188,21 @@ impl Descriptor for HisrMethod {
     }
 }
 
-/// HISR's points in the bench (docs/algorithm.md section 6.5): tau from its
-/// cheap end to its accurate one, shallower trees at the cheap end, two
-/// eye-space refinement thresholds and, where the RSM allows, one level
-/// deeper at the accurate end.
+/// HISR's points in the bench (docs/algorithm.md section 6.5), for the
+/// relative tau (the default mode): tau from its cheap end to its accurate
+/// one, shallower trees at the cheap end, two eye-space refinement
+/// thresholds, and the accurate end down to single RSM texels.
 fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     let tau = |t: f32| Params::new().with(&TAU, t);
-    // Large taus trace the cheap end of HISR's front (at tau 0.97 a valid
-    // patch splits only for receivers very near it, while invalid ones are
-    // still held to tau / 100); smaller max depths at the two largest taus
-    // go cheaper still.
+    // Large taus trace the cheap end of HISR's front: at tau 0.9 a valid
+    // patch splits only for receivers it nearly surrounds, while invalid
+    // ones are still held to tau / 100; smaller max depths at the two
+    // largest taus go cheaper still.
     let taus: &[f32] = if quick {
         &[0.2, 0.05]
     } else {
-        &[0.97, 0.94, 0.9, 0.75, 0.5, 0.2, 0.05, 0.01]
+        // 0.05, the default, at the default depth too.
+        &[0.9, 0.5, 0.3, 0.2, 0.1, 0.05]
     };
     let mut v: Vec<Params> = taus.iter().map(|&t| tau(t)).collect();
     if quick {
@@ -155,11 +210,11 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     }
     let at_rsm = RenderSettings {
         rsm_resolution: rsm,
-        ..RenderSettings::DEFAULT
+        ..Default::default()
     };
     let deepest = MAX_DEPTH.default_in(&at_rsm);
     let start = START_LEVEL.default_in(&at_rsm);
-    for t in [0.97, 0.9] {
+    for t in [0.9, 0.5] {
         for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
             if d >= start {
                 v.push(tau(t).with(&MAX_DEPTH, d));
@@ -169,12 +224,18 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     for t in [0.05, 0.3] {
         v.push(Params::new().with(&multires::DEPTH_THRESHOLD, t));
     }
-    // The accurate end: one level deeper (single RSM texels at RSM 128),
-    // where the default depth stops near the error of 4^6 = 4096 VPLs.
-    if at_rsm.rsm_top_level() > deepest {
-        for t in [0.2, 0.1, 0.05, 0.01] {
-            v.push(tau(t).with(&MAX_DEPTH, deepest + 1));
-        }
+    // The accurate end, down to single RSM texels. The default depth stops
+    // at the light patches of 4096 regular VPLs (64x64), so there the error
+    // floors at theirs whatever tau; at full depth tau alone sets it (about
+    // tau / 4 to tau / 1.6 against the dense gather, docs/algorithm.md 4.3).
+    let full = at_rsm.rsm_top_level();
+    let fine: &[f32] = if full > deepest {
+        &[0.1, 0.05, 0.02, 0.005]
+    } else {
+        &[0.02, 0.005]
+    };
+    for &t in fine {
+        v.push(tau(t).with(&MAX_DEPTH, full));
     }
     v
 }
