@@ -14,6 +14,7 @@ pub mod limits;
 pub mod motion;
 pub mod obj_load;
 pub mod one_texture;
+mod texture_decode;
 mod uri;
 
 pub use gltf_load::LoadOptions;

@@ -307,41 +307,5 @@ fn decode(path: &Path, limits: &limits::Limits, textures: &mut Textures) -> Resu
         || path.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(&bytes))
-            .with_guessed_format()
-            .map_err(|e| anyhow!("{label}: cannot read ({e})"))
-    };
-    let (w, h) = reader()?
-        .into_dimensions()
-        .map_err(|e| anyhow!("{label}: cannot decode ({e}); PNG and JPEG are supported"))?;
-    let max = limits.texture_dimension;
-    if w > max || h > max {
-        bail!("{label} is {w}x{h} pixels; textures may be at most {max}x{max}");
-    }
-    let pixels = w as u64 * h as u64;
-    let total = textures.pixels.saturating_add(pixels);
-    if total > limits.texture_pixels {
-        bail!(
-            "{label} is {w}x{h} = {pixels} pixels, which brings the textures to {total} pixels; the limit is {} pixels for all textures together",
-            limits.texture_pixels
-        );
-    }
-    textures.pixels = total;
-    let mut reader = reader()?;
-    let mut decode_limits = image::Limits::default();
-    decode_limits.max_image_width = Some(w);
-    decode_limits.max_image_height = Some(h);
-    decode_limits.max_alloc = Some(pixels.saturating_mul(8).saturating_add(1 << 20));
-    reader.limits(decode_limits);
-    let decoded = reader
-        .decode()
-        .map_err(|e| anyhow!("{label}: cannot decode ({e}); PNG and JPEG are supported"))?
-        .to_rgba8();
-    Ok(Texture {
-        name: label,
-        width: decoded.width(),
-        height: decoded.height(),
-        rgba8: decoded.into_raw(),
-    })
+    crate::scene::texture_decode::decode_texture(&bytes, label, limits, &mut textures.pixels)
 }

@@ -1,0 +1,54 @@
+//! Decoding a texture within the loaders' budgets (`limits`), shared by the
+//! glTF and OBJ loaders: the size from the header is checked before anything
+//! is decoded, and the decoder itself is held to it should the header lie.
+
+use super::{limits::Limits, Texture};
+use anyhow::{anyhow, bail, Result};
+
+/// `bytes` (PNG or JPEG) as an RGBA8 texture named `label`, adding its
+/// pixels to `pixels` (all textures of the file so far), or an error naming
+/// `label` and the limit it would pass.
+pub(super) fn decode_texture(
+    bytes: &[u8],
+    label: String,
+    limits: &Limits,
+    pixels: &mut u64,
+) -> Result<Texture> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| anyhow!("{label}: cannot read ({e})"))
+    };
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| anyhow!("{label}: cannot decode ({e}); PNG and JPEG are supported"))?;
+    let max = limits.texture_dimension;
+    if w > max || h > max {
+        bail!("{label} is {w}x{h} pixels; textures may be at most {max}x{max}");
+    }
+    let own = w as u64 * h as u64;
+    let total = pixels.saturating_add(own);
+    if total > limits.texture_pixels {
+        bail!(
+            "{label} is {w}x{h} = {own} pixels, which brings the textures to {total} pixels; the limit is {} pixels for all textures together",
+            limits.texture_pixels
+        );
+    }
+    *pixels = total;
+    let mut reader = reader()?;
+    let mut decode_limits = image::Limits::default();
+    decode_limits.max_image_width = Some(w);
+    decode_limits.max_image_height = Some(h);
+    decode_limits.max_alloc = Some(own.saturating_mul(8).saturating_add(1 << 20));
+    reader.limits(decode_limits);
+    let decoded = reader
+        .decode()
+        .map_err(|e| anyhow!("{label}: cannot decode ({e}); PNG and JPEG are supported"))?
+        .to_rgba8();
+    Ok(Texture {
+        name: label,
+        width: decoded.width(),
+        height: decoded.height(),
+        rgba8: decoded.into_raw(),
+    })
+}
