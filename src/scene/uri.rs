@@ -169,7 +169,7 @@ pub fn percent_decode(s: &str) -> Result<String> {
 }
 
 /// What a file is, for "not a regular file" messages.
-fn kind(t: std::fs::FileType) -> &'static str {
+pub(super) fn kind(t: std::fs::FileType) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt as _;

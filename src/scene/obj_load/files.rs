@@ -59,28 +59,6 @@ pub(in crate::scene) fn folder_of(name: &str, dir: &Path) -> PathBuf {
     }
 }
 
-/// What a file is, for "not a regular file" messages.
-fn kind(t: std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt as _;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a directory"
-    } else {
-        "not a regular file"
-    }
-}
-
 /// Opens `path` if it is a regular file of at most `max` bytes, checked
 /// before opening (a FIFO would block the open) and again on the handle, as
 /// `uri` does for buffers. Returns the file and its length.
@@ -90,7 +68,7 @@ pub(in crate::scene) fn open_regular(path: &Path, max: u64) -> Result<(std::fs::
             bail!(
                 "{} is {}: only regular files are read",
                 path.display(),
-                kind(meta.file_type())
+                uri::kind(meta.file_type())
             );
         }
         if meta.len() > max {
