@@ -53,18 +53,35 @@ fn court(light: Light) -> Scene {
 
 /// The pixels compared (`isr::bench::truth::truth_mask`), and how many
 /// were left out at geometric and at shadow edges.
-fn compared(
-    r: &Rendered,
-    traced: &Readback,
-    settings: &isr::settings::RenderSettings,
-) -> TruthMask {
+/// `scene`'s direct light rasterised at `n` x `n` (RSM 512) and path traced
+/// (one sample: direct light is exact and noise-free), and the truth mask
+/// they are compared on.
+fn rendered_and_traced(
+    gpu: &isr::vk::Gpu,
+    scene: &Scene,
+    n: u32,
+) -> (Rendered, Readback, TruthMask) {
+    let settings = sized("none", n, n, 512);
+    let rendered = render(gpu, scene, &settings, 1);
+    let traced = isr::pathtrace::render(
+        scene,
+        &isr::pathtrace::PathTraceSettings {
+            width: n,
+            height: n,
+            spp: 1,
+            seed: 1,
+            exposure: 1.0,
+        },
+        |_, _| {},
+    );
     let shadows = ShadowMaps::new(
-        &r.light_views,
-        r.origin,
+        &rendered.light_views,
+        rendered.origin,
         settings.rsm_resolution,
         settings.pcf_radius,
     );
-    truth_mask(&r.readback, &traced.direct, &shadows)
+    let mask = truth_mask(&rendered.readback, &traced.direct, &shadows);
+    (rendered, traced, mask)
 }
 
 #[test]
@@ -92,21 +109,8 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
     ];
     for (name, light) in lights {
         let scene = court(light);
-        let settings = sized("none", n, n, 512);
-        let rendered = render(&gpu, &scene, &settings, 1);
+        let (rendered, traced, compared) = rendered_and_traced(&gpu, &scene, n);
         let raster = &rendered.readback;
-        let traced = isr::pathtrace::render(
-            &scene,
-            &isr::pathtrace::PathTraceSettings {
-                width: n,
-                height: n,
-                spp: 1,
-                seed: 1,
-                exposure: 1.0,
-            },
-            |_, _| {},
-        );
-        let compared = compared(&rendered, &traced, &settings);
         let mask = &compared.mask;
         let kept = compared.kept();
         let lit = (0..mask.len())
@@ -171,21 +175,8 @@ fn direct_light_in_the_sibenik_cathedral_matches_the_path_tracer_away_from_edges
     ];
     for (name, light) in lights {
         scene.lights = vec![light];
-        let settings = sized("none", n, n, 512);
-        let rendered = render(&gpu, &scene, &settings, 1);
+        let (rendered, traced, compared) = rendered_and_traced(&gpu, &scene, n);
         let raster = &rendered.readback;
-        let traced = isr::pathtrace::render(
-            &scene,
-            &isr::pathtrace::PathTraceSettings {
-                width: n,
-                height: n,
-                spp: 1,
-                seed: 1,
-                exposure: 1.0,
-            },
-            |_, _| {},
-        );
-        let compared = compared(&rendered, &traced, &settings);
         let mask = &compared.mask;
         let kept = compared.kept();
         let shadowed = (0..mask.len())
