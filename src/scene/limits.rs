@@ -74,6 +74,36 @@ impl Limits {
     };
 }
 
+impl Limits {
+    /// That `scene`'s geometry is neither too far out nor too small for f32
+    /// rendering (`coordinate`, `min_extent`); `shrink` says how to scale a
+    /// scene down in the loader's terms. Its bounds if so.
+    pub fn check_extent(
+        &self,
+        scene: &super::Scene,
+        shrink: &str,
+    ) -> anyhow::Result<(glam::Vec3, glam::Vec3)> {
+        let (lo, hi) = scene
+            .bounds()
+            .ok_or_else(|| anyhow::anyhow!("the scene has no vertices to render"))?;
+        let reach = lo.abs().max(hi.abs()).max_element();
+        if reach.is_nan() || reach > self.coordinate {
+            anyhow::bail!(
+                "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m ({shrink})",
+                self.coordinate
+            );
+        }
+        let extent = (hi - lo).length();
+        if extent < self.min_extent {
+            anyhow::bail!(
+                "the scene is too small: its geometry spans {extent:.3e} m; isr renders in 32-bit floats and supports scenes at least {:.0e} m across (scale the scene up: images do not depend on the scale)",
+                self.min_extent
+            );
+        }
+        Ok((lo, hi))
+    }
+}
+
 impl Default for Limits {
     fn default() -> Self {
         Self::DEFAULT

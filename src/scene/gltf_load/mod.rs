@@ -190,23 +190,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     if out.instances.is_empty() {
         bail!("the scene has no triangle geometry to render");
     }
-    let (lo, hi) = out
-        .bounds()
-        .ok_or_else(|| anyhow!("the scene has no vertices to render"))?;
-    let reach = lo.abs().max(hi.abs()).max_element();
-    if reach.is_nan() || reach > limits.coordinate {
-        bail!(
-            "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m (scale the scene down)",
-            limits.coordinate
-        );
-    }
-    let extent = (hi - lo).length();
-    if extent < limits.min_extent {
-        bail!(
-            "the scene is too small: its geometry spans {extent:.3e} m; isr renders in 32-bit floats and supports scenes at least {:.0e} m across (scale the scene up: images do not depend on the scale)",
-            limits.min_extent
-        );
-    }
+    let (lo, hi) = limits.check_extent(&out, "scale the scene down")?;
     lights.sort_by_key(|&(node, _)| node);
     if lights.is_empty() {
         let l = fitted_light(lo, hi);

@@ -310,23 +310,10 @@ fn build(path: &Path, models: Vec<tobj::Model>, mut st: State, albedo: Vec3) -> 
             }
         );
     }
-    let (lo, hi) = scene
-        .bounds()
-        .ok_or_else(|| anyhow!("the scene has no vertices to render"))?;
-    let reach = lo.abs().max(hi.abs()).max_element();
-    if reach.is_nan() || reach > limits.coordinate {
-        bail!(
-            "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m (scale the scene down, e.g. with \"scale\" in a scene description)",
-            limits.coordinate
-        );
-    }
-    let extent = (hi - lo).length();
-    if extent < limits.min_extent {
-        bail!(
-            "the scene is too small: its geometry spans {extent:.3e} m; isr renders in 32-bit floats and supports scenes at least {:.0e} m across (scale the scene up: images do not depend on the scale)",
-            limits.min_extent
-        );
-    }
+    let (lo, hi) = limits.check_extent(
+        &scene,
+        "scale the scene down, e.g. with \"scale\" in a scene description",
+    )?;
     if degenerate > 0 {
         warnings.push(format!(
             "{degenerate} degenerate face(s) (zero area, or a vertex used twice) skipped"
