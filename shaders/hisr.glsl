@@ -10,7 +10,7 @@
 int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
 
 // The node's squared reach: patch j splits for receiver i iff
-// |V_ij|^2 <= reach. Invalid patches are held to tau * HISR_INVALID_TAU_SCALE.
+// |V_ij|^2 <= reach. Invalid patches have the reach over HISR_INVALID_TAU_SCALE.
 // Nodes at the max depth, and empty ones, never split: -1. light-tree-pack
 // stores it in the packed node's flux.a, so the traversal and the tile cut
 // test a node with one comparison and decide exactly alike.
@@ -24,14 +24,16 @@ int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 
 // factor 4^k, k the node's levels above the finest RSM texel.
 float hisr_reach(LightPatch lp, ivec3 node) {
     if (node.z >= run.hisr_max_depth || lp.position_area.w <= 0.0) return -1.0;
-    bool invalid = lp.normal.w == PATCH_INVALID;
+    float reach;
     if (run.hisr_tau_mode == HISR_TAU_RELATIVE) {
-        float tau = run.hisr_tau * (invalid ? HISR_INVALID_TAU_SCALE : 1.0);
-        return lp.position_area.w * (1.0 - tau) / (PI * tau);
+        reach = lp.position_area.w * (1.0 - run.hisr_tau) / (PI * run.hisr_tau);
+    } else {
+        int mip = run.rsm_top_level - node.z;
+        reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.hisr_threshold);
     }
-    int mip = run.rsm_top_level - node.z;
-    float reach = exp2(float(2 * mip)) * hisr_bound(lp.position_area.xyz, node, run.hisr_threshold);
-    if (invalid) reach /= HISR_INVALID_TAU_SCALE;
+    // Both forms hold invalid patches to the reach of s tau for small tau,
+    // and let them stop splitting as tau -> 1 (the cheap end).
+    if (lp.normal.w == PATCH_INVALID) reach /= HISR_INVALID_TAU_SCALE;
     return reach;
 }
 

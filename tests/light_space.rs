@@ -295,7 +295,7 @@ fn stats_and_vpl_count_view_from_the_cli() {
 /// log2 R - d (position and area, normal and state, flux), and in flux.a its
 /// squared reach (`hisr_reach`): with relative tau A (1 - tau) / (pi tau), A
 /// its area; with absolute tau (the spot light) 4^k T |p - light|^2, k its
-/// levels above the finest; invalid patches with tau times
+/// levels above the finest; invalid patches' reach over
 /// HISR_INVALID_TAU_SCALE; -1 at the max depth and for empty nodes. Depths
 /// below the max depth are never read, and not packed.
 #[test]
@@ -342,19 +342,20 @@ fn packed_tree_matches(mode: hisr::TauMode) {
                 let p = glam::DVec3::new(pos[i][0] as f64, pos[i][1] as f64, pos[i][2] as f64);
                 let scale = if nrm[i][3] == PATCH_INVALID {
                     invalid += 1;
-                    HISR_INVALID_TAU_SCALE as f64
+                    1.0 / HISR_INVALID_TAU_SCALE as f64
                 } else {
                     1.0
                 };
-                match mode {
-                    hisr::TauMode::Relative => {
-                        let tau = hisr::TAU.get(&s) as f64 * scale;
-                        pos[i][3] as f64 * (1.0 - tau) / (std::f64::consts::PI * tau)
+                scale
+                    * match mode {
+                        hisr::TauMode::Relative => {
+                            let tau = hisr::TAU.get(&s) as f64;
+                            pos[i][3] as f64 * (1.0 - tau) / (std::f64::consts::PI * tau)
+                        }
+                        hisr::TauMode::Absolute => {
+                            4f64.powi((top - d) as i32) * t * (p - light).length_squared()
+                        }
                     }
-                    hisr::TauMode::Absolute => {
-                        4f64.powi((top - d) as i32) * t * (p - light).length_squared() / scale
-                    }
-                }
             };
             let got = n.flux[3] as f64;
             assert!(

@@ -195,14 +195,14 @@ impl Descriptor for HisrMethod {
 fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     let tau = |t: f32| Params::new().with(&TAU, t);
     // Large taus trace the cheap end of HISR's front: at tau 0.9 a valid
-    // patch splits only for receivers it nearly surrounds, while invalid
-    // ones are still held to tau / 100; smaller max depths at the two
-    // largest taus go cheaper still.
+    // patch splits only for receivers it nearly surrounds, an invalid one
+    // within 10x that distance; smaller max depths at the two largest taus
+    // go cheaper still.
     let taus: &[f32] = if quick {
         &[0.2, 0.05]
     } else {
         // 0.05, the default, at the default depth too.
-        &[0.9, 0.5, 0.3, 0.2, 0.1, 0.05]
+        &[0.97, 0.9, 0.75, 0.5, 0.2, 0.05]
     };
     let mut v: Vec<Params> = taus.iter().map(|&t| tau(t)).collect();
     if quick {
@@ -214,7 +214,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     };
     let deepest = MAX_DEPTH.default_in(&at_rsm);
     let start = START_LEVEL.default_in(&at_rsm);
-    for t in [0.9, 0.5] {
+    for t in [0.97, 0.9] {
         for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
             if d >= start {
                 v.push(tau(t).with(&MAX_DEPTH, d));
@@ -230,7 +230,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     // tau / 4 to tau / 1.6 against the dense gather, docs/algorithm.md 4.3).
     let full = at_rsm.rsm_top_level();
     let fine: &[f32] = if full > deepest {
-        &[0.1, 0.05, 0.02, 0.005]
+        &[0.5, 0.2, 0.1, 0.05, 0.02, 0.005]
     } else {
         &[0.02, 0.005]
     };
