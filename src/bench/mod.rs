@@ -653,7 +653,7 @@ fn run_scene(
                 out.width,
                 out.height,
                 flip::PIXELS_PER_DEGREE,
-            );
+            )?;
             e_flip += flip::mean_flip(&map, &reference.mask);
             flicker.add(&out.indirect, &reference.indirect, &reference.mask);
             flicker_final.add(
