@@ -275,13 +275,19 @@ impl Plan {
     /// The journal key of a row.
     pub fn key(&self, scene: &str, method: &str, label: &str) -> String {
         let b = &self.base;
-        // The truth's noise too: its errors are part of the row.
+        // The truth's noise too: its errors are part of the row; and the
+        // flicker measure, so that rows of an older one are measured again.
         let truth = self
             .truth_noise
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         format!(
-            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}",
-            b.width, b.height, b.rsm_resolution, self.frames, self.timing_frames
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}",
+            b.width,
+            b.height,
+            b.rsm_resolution,
+            self.frames,
+            self.timing_frames,
+            metrics::FLICKER_MEASURE
         )
     }
 
@@ -613,8 +619,8 @@ fn run_scene(
             _ => None,
         };
         let mut stats = FrameStats::default();
-        let mut flicker = metrics::Flicker::default();
-        let mut flicker_final = metrics::Flicker::default();
+        let mut flicker = metrics::Flicker::new(plan.base.width, plan.base.height);
+        let mut flicker_final = metrics::Flicker::new(plan.base.width, plan.base.height);
         let (mut e_ind, mut e_fin, mut e_flip) = (0.0, 0.0, 0.0);
         let mut e_truth = None;
         let mut evals = None;
@@ -653,14 +659,14 @@ fn run_scene(
                 out.width,
                 out.height,
                 flip::PIXELS_PER_DEGREE,
-            );
+            )?;
             e_flip += flip::mean_flip(&map, &reference.mask);
-            flicker.add(&out.indirect, &reference.indirect, &reference.mask);
+            flicker.add(&out.indirect, &reference.indirect, &reference.mask)?;
             flicker_final.add(
                 &out.final_radiance,
                 &reference.final_radiance,
                 &reference.mask,
-            );
+            )?;
             if k + 1 == plan.frames {
                 evals = light_patch_evals(&r, &settings, &out)?;
             }
@@ -696,6 +702,7 @@ fn run_scene(
         row.flicker = flicker.flicker();
         row.flicker_second = flicker.second_difference();
         row.flicker_final = flicker_final.flicker();
+        row.flicker_pixel = flicker.per_pixel();
         row.light_patch_evals = evals;
         row.gpu_memory_bytes = memory;
         if bar.is_hidden() {
@@ -796,6 +803,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         flicker: None,
         flicker_second: None,
         flicker_final: None,
+        flicker_pixel: None,
         gpu_memory_bytes: None,
         truth: Default::default(),
     }

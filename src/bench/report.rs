@@ -145,8 +145,84 @@ pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
                 );
             }
         }
+        // What the flicker measure must tell apart (section 6.3): 64
+        // regular VPLs pop as the light moves, 4096 hardly do.
+        for base in regular() {
+            let Some((low, pixel)) = flicker_64_over_4096(rows, s, base) else {
+                continue;
+            };
+            push(
+                format!("flicker of {base} 64 / {base} 4096"),
+                Some(low.0 / low.1),
+                format!(
+                    "{:.4} against {:.4}; per pixel, without the low-pass, {}",
+                    low.0,
+                    low.1,
+                    pixel.map_or("-".into(), |(a, b)| format!(
+                        "{a:.4} against {b:.4} ({:.2})",
+                        a / b
+                    ))
+                ),
+            );
+        }
     }
     out
+}
+
+/// Flicker (low-passed) of `base` with 64 and with 4096 VPLs in `scene`,
+/// and the same per pixel where the rows have it.
+#[allow(clippy::type_complexity)]
+fn flicker_64_over_4096(
+    rows: &[Row],
+    scene: &str,
+    base: &str,
+) -> Option<((f64, f64), Option<(f64, f64)>)> {
+    let (a, b) = (find(rows, scene, base, 64)?, find(rows, scene, base, 4096)?);
+    let low = (a.flicker?, b.flicker?);
+    let pixel = a.flicker_pixel.zip(b.flicker_pixel);
+    Some((low, pixel))
+}
+
+/// `report.md`'s table of flicker with 64 over 4096 regular VPLs, per
+/// scene and method: low-passed, and per pixel in brackets.
+fn flicker_table(plan: &Plan, o: &Outcome) -> String {
+    let methods: Vec<&str> = regular()
+        .into_iter()
+        .filter(|m| {
+            plan.scenes
+                .iter()
+                .any(|s| flicker_64_over_4096(&o.rows, &s.name, m).is_some())
+        })
+        .collect();
+    if methods.is_empty() {
+        return String::new();
+    }
+    let mut md = "\n## Flicker: 64 against 4096 regular VPLs\n\nFlicker (section 6.3) with 64 VPLs over \
+flicker with 4096, per scene and method: low-passed (the measure), and in brackets per pixel (the measure \
+before the low-pass, which the dense reference's own near-contact change dominates on `fine` and \
+`slats`). Above 1: 64 VPLs flicker more.\n\n| scene |"
+        .to_string();
+    for m in &methods {
+        md += &format!(" {m} |");
+    }
+    md += "\n| --- |";
+    md += &" ---: |".repeat(methods.len());
+    md += "\n";
+    for s in &plan.scenes {
+        md += &format!("| {} |", s.name);
+        for m in &methods {
+            md += &match flicker_64_over_4096(&o.rows, &s.name, m) {
+                Some(((a, b), pixel)) => format!(
+                    " {:.2} ({}) |",
+                    a / b,
+                    pixel.map_or("-".into(), |(c, d)| format!("{:.2}", c / d))
+                ),
+                None => " - |".into(),
+            };
+        }
+        md += "\n";
+    }
+    md
 }
 
 /// Whether HISR's curve lies below every other method's (the issue's goal on
@@ -229,6 +305,7 @@ tone-mapped final image (section 6.4).{}\n\n",
 ![speed against error from the truth](speed_vs_truth.svg)\n\n![flicker](flicker.svg)\n\n\
 ![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n";
     md += &model_errors(plan, o);
+    md += &flicker_table(plan, o);
     md += "\n## Ratios\n\n\
 | scene | measure | value | detail |\n| --- | --- | ---: | --- |\n";
     for r in ratios {
@@ -374,6 +451,29 @@ mod tests {
         r.flicker = Some(flicker);
         r.is_default = method == "hisr" && ms == 10.0;
         r
+    }
+
+    #[test]
+    fn flicker_of_64_over_4096_vpls_per_method() {
+        let mut a = row("multires-gather", Some(64), 5.0, 0.5, 0.06);
+        a.flicker_pixel = Some(0.09);
+        let mut b = row("multires-gather", Some(4096), 200.0, 0.1, 0.02);
+        b.flicker_pixel = Some(0.1);
+        // rsm-gather has no 4096 row: no ratio.
+        let c = row("rsm-gather", Some(64), 5.0, 0.5, 0.06);
+        let r = ratios(&[a, b, c]);
+        let f: Vec<&Ratio> = r.iter().filter(|x| x.measure.contains("64 / ")).collect();
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(
+            f[0].measure,
+            "flicker of multires-gather 64 / multires-gather 4096"
+        );
+        assert!((f[0].value.unwrap() - 3.0).abs() < 1e-12);
+        assert!(
+            f[0].detail.ends_with("0.0900 against 0.1000 (0.90)"),
+            "{}",
+            f[0].detail
+        );
     }
 
     #[test]

@@ -39,11 +39,16 @@ pub struct Row {
     pub rel_rmse_indirect: f64,
     pub rel_rmse_final: f64,
     pub flip: f64,
-    /// Section 6.3 on the indirect image; `None` for a single frame.
+    /// Section 6.3 on the indirect image, low-passed (first and second
+    /// differences); `None` for a single frame.
     pub flicker: Option<f64>,
     pub flicker_second: Option<f64>,
     /// Section 6.3 on the final image.
     pub flicker_final: Option<f64>,
+    /// The indirect image's first difference per pixel, without the
+    /// low-pass (the measure before it, for comparison).
+    #[serde(default)]
+    pub flicker_pixel: Option<f64>,
     /// GPU memory the method's resources take: the allocator's total with the
     /// method's renderer minus that with `--method none`.
     pub gpu_memory_bytes: Option<i64>,
@@ -212,7 +217,7 @@ pub fn to_csv(rows: &[Row]) -> String {
     }
     out += ",width,height,rsm,frames,indirect_ms,indirect_ms_min,total_ms,fragment_invocations,\
 light_patch_evals,rel_rmse_indirect,rel_rmse_final,flip,flicker,flicker_second,flicker_final,\
-gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out,truth_floor";
+flicker_pixel,gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out,truth_floor";
     for p in &passes {
         out += &format!(",{p}_ms");
     }
@@ -245,6 +250,7 @@ gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_out,truth_floor
             opt(&r.flicker),
             opt(&r.flicker_second),
             opt(&r.flicker_final),
+            opt(&r.flicker_pixel),
             opt(&r.gpu_memory_bytes),
             opt(&r.truth.rel_rmse_indirect),
             opt(&r.truth.spp),
@@ -293,6 +299,7 @@ pub(crate) mod tests_support {
             flicker: Some(0.01),
             flicker_second: None,
             flicker_final: Some(0.005),
+            flicker_pixel: Some(0.02),
             gpu_memory_bytes: Some(1024),
             truth: TruthErrors {
                 rel_rmse_indirect: Some(0.12),
