@@ -47,9 +47,12 @@ pub const MAX_DEPTH: Param<u32> = Param {
     name: "max-depth",
     help: "HISR subdivides at most down to 2^d x 2^d light patches (at most log2 of --rsm); \
            patches spanning a discontinuity are held to 1/100 of tau",
+    // Single RSM texels up to RSM 256, so that tau sets the error
+    // (docs/algorithm.md 4.3); beyond, depth 8 bounds the packed tree
+    // (87,381 nodes, 4 MiB) and the traversal whatever the RSM.
     default: DefaultValue::Derived(
-        |s| 6.min(s.rsm_top_level()),
-        "6, or log2 of --rsm if smaller",
+        |s| 8.min(s.rsm_top_level()),
+        "8, or log2 of --rsm if smaller",
     ),
     range: Range::closed(0.0, MAX_TREE_DEPTH),
 };
@@ -59,7 +62,7 @@ pub const TAU: Param<f32> = Param {
     help: "HISR's error threshold: a light patch is subdivided while its solid angle seen \
            from the receiver exceeds tau (--hisr-tau-mode relative), or while its contribution \
            could exceed tau * I (absolute)",
-    default: DefaultValue::Fixed(0.05),
+    default: DefaultValue::Fixed(0.2),
     range: Range::open(0.0, 1.0),
 };
 
@@ -191,22 +194,12 @@ impl Descriptor for HisrMethod {
 /// HISR's points in the bench (docs/algorithm.md section 6.5), for the
 /// relative tau (the default mode): tau from its cheap end to its accurate
 /// one, shallower trees at the cheap end, two eye-space refinement
-/// thresholds, and the accurate end down to single RSM texels.
+/// thresholds, and the accurate end at the default depth.
 fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     let tau = |t: f32| Params::new().with(&TAU, t);
-    // Large taus trace the cheap end of HISR's front: at tau 0.9 a valid
-    // patch splits only for receivers it nearly surrounds, an invalid one
-    // within 10x that distance; smaller max depths at the two largest taus
-    // go cheaper still.
-    let taus: &[f32] = if quick {
-        &[0.2, 0.05]
-    } else {
-        // 0.05, the default, at the default depth too.
-        &[0.97, 0.9, 0.75, 0.5, 0.2, 0.05]
-    };
-    let mut v: Vec<Params> = taus.iter().map(|&t| tau(t)).collect();
     if quick {
-        return v;
+        // 0.2, the default.
+        return vec![tau(0.2), tau(0.05)];
     }
     let at_rsm = RenderSettings {
         rsm_resolution: rsm,
@@ -214,28 +207,40 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     };
     let deepest = MAX_DEPTH.default_in(&at_rsm);
     let start = START_LEVEL.default_in(&at_rsm);
+    let mut v: Vec<Params> = vec![];
+    let mut add = |p: Params| {
+        if !v.contains(&p) {
+            v.push(p);
+        }
+    };
+    // The accurate end, at the default depth (single RSM texels up to RSM
+    // 256), where tau alone sets the error: about tau / 4 to tau / 1.6
+    // against the dense gather (docs/algorithm.md 4.3). 0.2 is the default.
+    for t in [0.5, 0.2, 0.1, 0.05, 0.02, 0.005] {
+        add(tau(t));
+    }
+    // Large taus trace the cheap end of HISR's front: at tau 0.9 a valid
+    // patch splits only for receivers it nearly surrounds, an invalid one
+    // within 10x that distance. Depth 6 stops at the light patches of 4096
+    // regular VPLs, and depths 3 and 4 at the two largest taus go cheaper
+    // still.
+    let floor = 6.min(deepest);
+    for t in [0.97, 0.9, 0.75, 0.5, 0.2] {
+        add(if floor == deepest {
+            tau(t)
+        } else {
+            tau(t).with(&MAX_DEPTH, floor)
+        });
+    }
     for t in [0.97, 0.9] {
-        for d in [deepest.saturating_sub(3), deepest.saturating_sub(2)] {
-            if d >= start {
-                v.push(tau(t).with(&MAX_DEPTH, d));
+        for d in [3, 4] {
+            if d >= start && d < deepest {
+                add(tau(t).with(&MAX_DEPTH, d));
             }
         }
     }
     for t in [0.05, 0.3] {
-        v.push(Params::new().with(&multires::DEPTH_THRESHOLD, t));
-    }
-    // The accurate end, down to single RSM texels. The default depth stops
-    // at the light patches of 4096 regular VPLs (64x64), so there the error
-    // floors at theirs whatever tau; at full depth tau alone sets it (about
-    // tau / 4 to tau / 1.6 against the dense gather, docs/algorithm.md 4.3).
-    let full = at_rsm.rsm_top_level();
-    let fine: &[f32] = if full > deepest {
-        &[0.5, 0.2, 0.1, 0.05, 0.02, 0.005]
-    } else {
-        &[0.02, 0.005]
-    };
-    for &t in fine {
-        v.push(tau(t).with(&MAX_DEPTH, full));
+        add(Params::new().with(&multires::DEPTH_THRESHOLD, t));
     }
     v
 }
