@@ -101,7 +101,10 @@ fn modules_depend_only_on_lower_layers() {
             continue;
         }
         let Some(&own) = layer.get(module.as_str()) else {
-            panic!("module {module} ({}) is in no layer of LAYERS", relative.display());
+            panic!(
+                "module {module} ({}) is in no layer of LAYERS",
+                relative.display()
+            );
         };
         seen_modules.insert(module.clone());
         let text = std::fs::read_to_string(file).unwrap();
@@ -122,10 +125,17 @@ fn modules_depend_only_on_lower_layers() {
             }
         }
     }
-    assert!(wrong.is_empty(), "imports running up or sideways:\n{}", wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "imports running up or sideways:\n{}",
+        wrong.join("\n")
+    );
     // Every layer's module exists (the table is not stale).
     for m in layer.keys() {
-        assert!(seen_modules.contains(*m), "LAYERS names {m}, which src/ lacks");
+        assert!(
+            seen_modules.contains(*m),
+            "LAYERS names {m}, which src/ lacks"
+        );
     }
 }
 
