@@ -74,22 +74,31 @@ fn main() -> anyhow::Result<()> {
         "isr (base 64)".into(),
         base.clone().with_method(isr::methods::isr::KEY),
     ));
-    // The HISR curve (default tiles), then below 4096 VPLs' error, where HISR
-    // needs patches finer than theirs (depth 6 is their level), depth 7; one
-    // point without tiles (every fragment traverses from the roots) for
-    // comparison.
-    for tau in [0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005] {
+    // The HISR curve at its default depth (8: single texels at RSM 256),
+    // where tau sets the error; then depth 6, whose finest patches are
+    // those of 4096 regular VPLs; the talk's absolute tau at depth 6 (the
+    // defaults before relative tau); one point without tiles (every fragment
+    // traverses from the roots) for comparison.
+    for tau in [0.5, 0.2, 0.1, 0.05, 0.02, 0.01] {
         configs.push((format!("hisr tau {tau}"), hisr(tau)));
     }
-    for tau in [0.5, 0.2, 0.1, 0.05, 0.02, 0.01] {
+    for tau in [0.5, 0.2, 0.05] {
         configs.push((
-            format!("hisr tau {tau}, depth 7"),
-            hisr(tau).with(&hisr::MAX_DEPTH, 7),
+            format!("hisr tau {tau}, depth 6"),
+            hisr(tau).with(&hisr::MAX_DEPTH, 6),
+        ));
+    }
+    for tau in [0.2, 0.05, 0.01] {
+        configs.push((
+            format!("absolute tau {tau}, depth 6"),
+            hisr(tau)
+                .with(&hisr::MAX_DEPTH, 6)
+                .with(&hisr::TAU_MODE, hisr::TauMode::Absolute),
         ));
     }
     configs.push((
-        "hisr tau 0.05, no tiles".into(),
-        hisr(0.05).with(&hisr::TILE_LEVEL, 0),
+        "hisr tau 0.2, no tiles".into(),
+        hisr(0.2).with(&hisr::TILE_LEVEL, 0),
     ));
     // Rounds over every row in turn, each row's time the least over all its
     // frames: a slow spell of the shared machine then touches every row alike
@@ -179,8 +188,16 @@ fn main() -> anyhow::Result<()> {
 }
 
 /// HISR's time at `error` on `curve` ((ms, error) by falling error), log-log
-/// interpolated between the two points that bracket it.
+/// interpolated between the two points that bracket it; at errors above
+/// its cheapest point, that point's time.
 fn hisr_time_at(curve: &[(f64, f64)], error: f64) -> Option<f64> {
+    // An error above the curve's cheapest point: that point reaches it, in
+    // its time (interpolating would need a cheaper point than any measured).
+    if let Some(&(t, e)) = curve.first() {
+        if error >= e {
+            return Some(t);
+        }
+    }
     curve.windows(2).find_map(|w| {
         let ((t0, e0), (t1, e1)) = (w[0], w[1]);
         let (lo, hi) = (e0.min(e1), e0.max(e1));
