@@ -62,10 +62,13 @@ void patch_list(vec3 xi, vec3 ni) {
     }
 }
 
-// Hierarchical ISR (docs/algorithm.md section 4): subdivide patch j while its
-// contribution to this receiver could exceed tau.
+// Hierarchical ISR (docs/algorithm.md section 4.3): subdivide patch j while
+// its form factor seen from this receiver exceeds tau (relative tau, the
+// default: hisr_reach in hisr.glsl), or, with --hisr-tau-mode absolute, while
+// its contribution could exceed tau times the light's peak intensity, derived
+// here.
 //
-// The bound. With rho <= 1 and both cosines <= 1, Phi_j = rho_j I dw_j and
+// The absolute bound. With rho <= 1 and both cosines <= 1, Phi_j = rho_j I dw_j and
 // A_j = dw_j |V_j|^2 / cos_j >= dw_j |V_j|^2 (section 2) give
 //   C_{j->i} <= I dw_j / (pi |V_ij|^2 + dw_j |V_j|^2).
 // The talk takes one texel's solid angle as dw = 2 pi / (3 R^2) and scales by

@@ -51,8 +51,6 @@ fn court(light: Light) -> Scene {
     s
 }
 
-/// The pixels compared (`isr::bench::truth::truth_mask`), and how many
-/// were left out at geometric and at shadow edges.
 /// `scene`'s direct light rasterised at `n` x `n` (RSM 512) and path traced
 /// (one sample: direct light is exact and noise-free), and the truth mask
 /// they are compared on.

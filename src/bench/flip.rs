@@ -21,7 +21,8 @@ fn rgb(rgba: &[u8]) -> Vec<u8> {
 
 /// Per-pixel FLIP of `test` against `reference`, both sRGB RGBA8 rows of
 /// `width x height`. Images of another size than `width x height` are an
-/// error (the C++ would read past them).
+/// error (the crate asserts on short ones, and would read only part of
+/// long ones).
 pub fn flip_map(
     reference: &[u8],
     test: &[u8],

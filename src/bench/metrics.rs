@@ -65,14 +65,12 @@ fn gaussian(sigma: f64) -> Vec<f64> {
 /// toward zero. Separable; zero where no masked pixel is near.
 fn low_pass(x: &[[f64; 3]], mask: &[bool], w: usize, h: usize, kernel: &[f64]) -> Vec<[f64; 3]> {
     let r = (kernel.len() / 2) as i64;
-    // Four planes: the three channels times the mask, and the mask.
+    // Four planes: the three channels inside the mask (zero outside, so
+    // that nothing there, not even a NaN, reaches the blur), and the mask.
     let planes: Vec<[f64; 4]> = x
         .iter()
         .zip(mask)
-        .map(|(v, &m)| {
-            let m = m as u8 as f64;
-            [v[0] * m, v[1] * m, v[2] * m, m]
-        })
+        .map(|(v, &m)| if m { [v[0], v[1], v[2], 1.0] } else { [0.0; 4] })
         .collect();
     let pass = |src: &[[f64; 4]], step: (i64, i64)| -> Vec<[f64; 4]> {
         let mut out = vec![[0.0; 4]; w * h];

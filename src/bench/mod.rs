@@ -548,7 +548,9 @@ fn run_scene(
             let truth = if with_truth {
                 let posed = state.pose(scene);
                 let t = frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
-                if k == plan.frames / 2 {
+                // Only the reference's row keeps the floor: minutes of rays
+                // when not cached, so not traced for a row already measured.
+                if ref_row && k == plan.frames / 2 {
                     let exact = model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
                     model.floor = Some(metrics::relative_rmse(
                         &exact,

@@ -353,16 +353,19 @@ tone-mapped final image (section 6.4).{}\n\n",
 /// truth, what every VPL method shares (it ignores indirect visibility),
 /// with how the truth was made and what its mask left out.
 fn model_errors(plan: &Plan, o: &Outcome) -> String {
-    let mut md = "## Model error\n\nThe dense reference (every RSM texel a VPL, no indirect visibility) \
+    let target = plan
+        .truth_noise
+        .map_or("the target".to_string(), |n| format!("{:.0}%", 100.0 * n));
+    let mut md = format!("## Model error\n\nThe dense reference (every RSM texel a VPL, no indirect visibility) \
 against the path-traced truth (one bounce with visibility, samples doubled until its own noise is under \
-2%), over the pixels away from geometric and direct-shadow edges (docs/algorithm.md section 6.6). A \
-method's error against the truth cannot fall far below its scene's model error. With exact visibility \
-(`--visibility exact`: one ray per pixel and VPL, on the CPU, at the middle frame) the dense reference \
-shows the floor of the VPL model itself. The truth's noise adds to every error against it in \
-quadrature.\n\n\
+{target}, or under less where a truth traced before for a tighter target is reused), over the pixels away \
+from geometric and direct-shadow edges (docs/algorithm.md section 6.6): what every VPL method without \
+visibility shares. A method can read below it where its own errors and the missing occlusion partly \
+cancel, so compare methods against the reference. With exact visibility (`--visibility exact`: one ray \
+per pixel and VPL, on the CPU, at the middle frame) the dense reference shows the floor of the VPL model \
+itself. The truth's noise adds to every error against it in quadrature.\n\n\
 | scene | model error | with exact visibility | truth spp | truth noise | pixels left out |\n\
-| --- | ---: | ---: | ---: | ---: | ---: |\n"
-        .to_string();
+| --- | ---: | ---: | ---: | ---: | ---: |\n");
     for s in &plan.scenes {
         let Some(r) = o
             .rows
