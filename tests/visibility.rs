@@ -664,3 +664,37 @@ fn voxel_visibility_on_the_bench_scenes_against_the_truth() {
         assert!(e[1] < e[0] && e[2] < e[0], "{}: {e:?}", b.name);
     }
 }
+
+#[test]
+fn a_method_switch_uses_the_grid_made_with_the_run_and_refuses_one_never_made() {
+    // The viewer switches methods within a run: the grid is made with the
+    // run whenever --visibility voxels is set, and used by the methods
+    // that read it.
+    let gpu = gpu();
+    let scene = cornell(true);
+    let hisr = voxels(sized("hisr", 32, 32, 32), 32);
+    let mut r =
+        isr::renderer::Renderer::new(&gpu, &scene, &voxels(sized("none", 32, 32, 32), 32)).unwrap();
+    assert!(
+        r.visibility_grid().is_none(),
+        "direct light alone reads no grid"
+    );
+    r.render_frames(1, |_| {}).unwrap();
+    r.set_method_settings(&hisr).unwrap();
+    assert!(r.visibility_grid().is_some());
+    r.render_frames(1, |_| {}).unwrap();
+    let switched = r.readback().unwrap();
+    drop(r);
+    let fresh = render(&gpu, &scene, &hisr, 1).readback;
+    let mask = geometry_mask(&fresh.position);
+    let e = relative_rmse(&switched.indirect, &fresh.indirect, &mask);
+    assert!(e < 1e-6, "{e}");
+    let without = render(&gpu, &scene, &sized("hisr", 32, 32, 32), 1).readback;
+    assert!(relative_rmse(&without.indirect, &fresh.indirect, &mask) > 0.02);
+    // A run made without the grid cannot switch to it.
+    let mut plain = isr::renderer::Renderer::new(&gpu, &scene, &sized("hisr", 32, 32, 32)).unwrap();
+    let err = plain.set_method_settings(&hisr).unwrap_err().to_string();
+    assert!(err.contains("start isr with them"), "{err}");
+    drop(plain);
+    assert_validation_clean(&gpu);
+}

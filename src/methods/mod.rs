@@ -234,11 +234,10 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
     } else {
         0
     };
-    let grid = if d.reads_visibility() {
-        visibility_grid::memory(s)
-    } else {
-        0
-    };
+    // The grid is made for the run whenever `--visibility voxels` is set
+    // (the viewer may switch to a method that reads it), so it counts
+    // whatever the method.
+    let grid = visibility_grid::memory(s);
     multires + grid + d.memory(s)
 }
 

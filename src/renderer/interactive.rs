@@ -111,8 +111,8 @@ impl<'g> Renderer<'g> {
             && (self.visibility_pass.is_none() || grid.get(settings) != grid.get(&self.settings))
         {
             bail!(
-                "--visibility voxels with --visibility-grid {} is made when the run starts: \
-                 start it with those options",
+                "the voxel visibility grid is made when the run starts: to use --visibility \
+                 voxels with --visibility-grid {}, start isr with them",
                 grid.get(settings)
             );
         }

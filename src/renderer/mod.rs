@@ -230,8 +230,10 @@ impl<'g> Renderer<'g> {
         } else {
             None
         };
+        // Made with `--visibility voxels` whatever the method, so that the
+        // viewer can switch to one that reads it; recorded only for those.
         let grid_in_use = reads_grid(descriptor, settings);
-        let visibility_pass = match grid_in_use {
+        let visibility_pass = match visibility_grid::uses_voxels(settings) {
             true => Some(VisibilityGridPass::new(&setup, &visibility_grid)?),
             false => None,
         };
