@@ -46,7 +46,7 @@ const int VISIBILITY_MAX_ITERATIONS = 13;
 // ends' skipped parts, else 0. ni, nj: unit normals of the receiver and the
 // patch (the rise over each one's plane is where the contribution is not 0).
 // A hierarchical DDA: at each point, the coarsest level whose cell there is
-// empty is skipped whole; an occupied cell is entered one level finer; an
+// empty is skipped whole (found from level 1 up); an occupied cell is entered one level finer; an
 // occupied finest cell blocks; after leaving a cell the march climbs a level
 // only where it also left the parent cell.
 float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
@@ -69,7 +69,9 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
     vec3 ahead = vec3(greaterThan(ds, vec3(0.0)));
     float eps = 1e-3 / length(d);  // a thousandth of a cell along the segment
     int top = run.visibility_levels - 1;
-    int k = top;
+    // Start one level up: the march starts near the receiver's surface,
+    // where the coarse cells are occupied (it climbs as it leaves parents).
+    int k = min(1, top);
     float t = t0;
     ivec3 last_cell = ivec3(run.visibility_side - 1);
     float visible = 1.0;
