@@ -31,6 +31,8 @@ struct FrameUniforms {
     int pad3;
     mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
+    vec4 visibility_grid;   // the voxel visibility grid's cube around this frame's posed scene:
+                            // xyz its min corner (m), w the side of a finest cell (m)
 };
 
 // light_kind: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
@@ -79,7 +81,17 @@ struct RunUniforms {
     // hisr_reach in hisr.glsl).
     float hisr_tau;               // --tau
     int hisr_tau_mode;            // HISR_TAU_*
+    // Indirect visibility (docs/algorithm.md section 5, "Voxel visibility";
+    // passes::visibility_grid).
+    int visibility;               // VISIBILITY_*: the term the patch formula applies
+    int visibility_side;          // N: finest cells per side of the grid (a power of 2)
+    int visibility_levels;        // levels 0..visibility_levels-1, side N >> k (at least 4)
+    int pad_visibility;
 };
+
+// RunUniforms::visibility: which visibility term patch_irradiance applies (vpl.glsl).
+const int VISIBILITY_NONE = 0;    // none: every patch lights every receiver it faces
+const int VISIBILITY_VOXELS = 1;  // the segment marched through the occupancy grid (visibility.glsl)
 
 // RunUniforms::hisr_tau_mode: what HISR's tau bounds (docs/algorithm.md 4.3).
 const int HISR_TAU_RELATIVE = 0;  // each evaluated patch's solid angle seen from the receiver
@@ -153,6 +165,16 @@ struct MaterialGpu {
     int pad0;
     int pad1;
     int pad2;
+};
+
+// Push constants of one dispatch of pass visibility-grid (visibility_grid.comp):
+// a range of one instance's triangles, one invocation each.
+struct VisibilityGridPush {
+    uint first_index;     // the instance's mesh's first index
+    int vertex_offset;    // added to its indices
+    uint instance;        // index into the frame's InstanceTransform array
+    uint first_triangle;  // this dispatch's first triangle of the mesh
+    uint triangles;       // this dispatch's triangle count
 };
 
 // Push constants of one scene draw.

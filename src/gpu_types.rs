@@ -39,6 +39,10 @@ pub struct FrameUniforms {
     pub pad3: i32,
     /// Point lights: world -> clip of each cube face, for the layered draw.
     pub cube_view_proj: [[[f32; 4]; 4]; 6],
+    /// The voxel visibility grid's cube around this frame's posed scene: xyz
+    /// its min corner, w a finest cell's side (m;
+    /// `passes::visibility_grid::grid_cube`).
+    pub visibility_grid: [f32; 4],
 }
 
 /// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.
@@ -82,6 +86,28 @@ pub struct RunUniforms {
     /// HISR's tau and `HISR_TAU_*` (`methods::hisr`).
     pub hisr_tau: f32,
     pub hisr_tau_mode: i32,
+    /// Indirect visibility (`passes::visibility_grid::write_uniforms`):
+    /// `VISIBILITY_*`, the grid's finest side N and its level count.
+    pub visibility: i32,
+    pub visibility_side: i32,
+    pub visibility_levels: i32,
+    pub pad_visibility: i32,
+}
+
+/// `RunUniforms::visibility` values, as in `shaders/shared.glsl`.
+pub const VISIBILITY_NONE: i32 = 0;
+pub const VISIBILITY_VOXELS: i32 = 1;
+
+/// `VisibilityGridPush`: one dispatch of pass `visibility-grid`, a range of
+/// one instance's triangles.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct VisibilityGridPush {
+    pub first_index: u32,
+    pub vertex_offset: i32,
+    pub instance: u32,
+    pub first_triangle: u32,
+    pub triangles: u32,
 }
 
 /// `RunUniforms::hisr_tau_mode` values, as in `shaders/shared.glsl`.

@@ -3,7 +3,7 @@
 //! whether a VPL can see the receiver it lights, which the VPL methods
 //! here do not model.
 //!
-//! `--visibility exact` (`methods::reference::VISIBILITY`) is the limit,
+//! `--visibility exact` (`passes::visibility_grid::VISIBILITY`) is the limit,
 //! for the dense `reference`: its gather
 //! (every RSM texel a VPL, `shaders/rsm_gather.frag`'s `patch_irradiance`)
 //! run on the CPU with one ray per (receiver, VPL) through the path tracer's

@@ -2,7 +2,8 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu, RunUniforms,
+    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu,
+    RunUniforms, VisibilityGridPush,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
@@ -93,7 +94,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", cube_view_proj: 384, [
+        check!(shader, FrameUniforms, "FrameUniforms", visibility_grid: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -115,6 +116,7 @@ fn frame_uniforms_match_shared_glsl() {
             pad2 => "pad2",
             pad3 => "pad3",
             cube_view_proj => "cube_view_proj",
+            visibility_grid => "visibility_grid",
         ]);
     }
 }
@@ -122,7 +124,7 @@ fn frame_uniforms_match_shared_glsl() {
 #[test]
 fn run_uniforms_match_shared_glsl() {
     for shader in ["direct_light.frag", "gather.frag", "upsample.comp"] {
-        check!(shader, RunUniforms, "RunUniforms", hisr_tau_mode: 4, [
+        check!(shader, RunUniforms, "RunUniforms", pad_visibility: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
             pcf_radius => "pcf_radius",
@@ -146,6 +148,10 @@ fn run_uniforms_match_shared_glsl() {
             splat_threshold => "splat_threshold",
             hisr_tau => "hisr_tau",
             hisr_tau_mode => "hisr_tau_mode",
+            visibility => "visibility",
+            visibility_side => "visibility_side",
+            visibility_levels => "visibility_levels",
+            pad_visibility => "pad_visibility",
         ]);
     }
 }
@@ -194,6 +200,17 @@ fn draw_push_matches_shared_glsl() {
     check!("scene.vert", DrawPush, "DrawPush", material: 4, [
         instance => "instance",
         material => "material",
+    ]);
+}
+
+#[test]
+fn visibility_grid_push_matches_shared_glsl() {
+    check!("visibility_grid.comp", VisibilityGridPush, "VisibilityGridPush", triangles: 4, [
+        first_index => "first_index",
+        vertex_offset => "vertex_offset",
+        instance => "instance",
+        first_triangle => "first_triangle",
+        triangles => "triangles",
     ]);
 }
 
@@ -252,6 +269,8 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("HISR_TAU_RELATIVE"), HISR_TAU_RELATIVE as u32);
     assert_eq!(value("HISR_TAU_ABSOLUTE"), HISR_TAU_ABSOLUTE as u32);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
+    assert_eq!(value("VISIBILITY_NONE"), VISIBILITY_NONE as u32);
+    assert_eq!(value("VISIBILITY_VOXELS"), VISIBILITY_VOXELS as u32);
     assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {
         let line = glsl
@@ -313,6 +332,12 @@ mod bindings {
             ubo("Run"),
             BindingInfo {
                 name: "Transforms",
+                kind: Kind::StorageBuffer,
+            },
+            // Read by the patch formula (visibility.glsl), written by
+            // visibility_grid.comp.
+            BindingInfo {
+                name: "VisibilityGrid",
                 kind: Kind::StorageBuffer,
             },
         ]

@@ -41,6 +41,7 @@ struct Probe<'g> {
     renderer: Renderer<'g>,
     frame: FrameSet,
     _run: Buffer,
+    _grid: Buffer,
     _samplers: Samplers,
     lpv: Lpv,
     profiler: Profiler,
@@ -56,7 +57,8 @@ impl<'g> Probe<'g> {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )
         .unwrap();
-        let frame = FrameSet::new(gpu, &run, scene.instances.len()).unwrap();
+        let grid = isr::passes::visibility_grid::grid_buffer(gpu, settings).unwrap();
+        let frame = FrameSet::new(gpu, &run, &grid, scene.instances.len()).unwrap();
         let samplers = Samplers::new(gpu).unwrap();
         let lpv = Lpv::new(&Setup {
             gpu,
@@ -72,6 +74,7 @@ impl<'g> Probe<'g> {
             renderer,
             frame,
             _run: run,
+            _grid: grid,
             _samplers: samplers,
             lpv,
             profiler: Profiler::new(gpu, 16).unwrap(),

@@ -280,8 +280,15 @@ impl Plan {
         let truth = self
             .truth_noise
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
+        // With the voxel grid on (`--visibility voxels`), rows are kept
+        // apart from a run's without it, so both can share a directory.
+        use crate::passes::visibility_grid::{uses_voxels, GRID};
+        let visibility = match uses_voxels(b) {
+            true => format!("|voxels {}", GRID.get(b)),
+            false => String::new(),
+        };
         format!(
-            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}",
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}{visibility}",
             b.width,
             b.height,
             b.rsm_resolution,

@@ -322,8 +322,9 @@ fn render(args: RenderArgs) -> Result<()> {
     // The settings' own checks need no device: they fail before it starts.
     crate::frame::check::check_ranges(&settings)?;
     crate::methods::check(&settings)?;
-    let exact = crate::methods::reference::VISIBILITY.get(&settings)
-        == crate::methods::reference::Visibility::Exact;
+    use crate::passes::visibility_grid::{Visibility, VISIBILITY};
+    let exact =
+        descriptor.takes_exact_visibility() && VISIBILITY.get(&settings) == Visibility::Exact;
     if exact && args.sequence.is_some() {
         bail!("--visibility exact renders one frame (it is the CPU limit, minutes a frame); drop --sequence");
     }

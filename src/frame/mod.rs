@@ -51,7 +51,9 @@ pub struct FrameContext<'a> {
 /// One frame in flight's copy of what changes per frame: the frame uniforms
 /// and the instance transforms (host-visible, written before the frame is
 /// submitted, after the previous frame that used them has finished), and the
-/// frame set that binds them with the run's fixed uniforms.
+/// frame set that binds them with the run's fixed uniforms and the voxel
+/// visibility grid (`passes::visibility_grid`; one grid for every frame set,
+/// rebuilt by each frame on the GPU behind a barrier).
 pub struct FrameSet {
     pub uniforms: Buffer,
     pub transforms: Buffer,
@@ -59,7 +61,7 @@ pub struct FrameSet {
 }
 
 impl FrameSet {
-    pub fn new(gpu: &Gpu, run: &Buffer, instances: usize) -> Result<Self> {
+    pub fn new(gpu: &Gpu, run: &Buffer, grid: &Buffer, instances: usize) -> Result<Self> {
         let uniforms = Buffer::new(
             gpu,
             "frame uniforms",
@@ -81,6 +83,7 @@ impl FrameSet {
                 Binding::uniform("Frame", &uniforms),
                 Binding::uniform("Run", run),
                 Binding::storage("Transforms", &transforms),
+                Binding::storage("VisibilityGrid", grid),
             ],
         )?;
         Ok(Self {

@@ -109,9 +109,11 @@ impl SceneGpu {
             .into_iter()
             .map(|t| upload_texture(gpu, t))
             .collect::<Result<Vec<_>>>()?;
-        let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+        // Storage too: the visibility grid's voxelization reads the triangles
+        // (`passes::visibility_grid`).
+        let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
         let vertices = Buffer::with_data(gpu, "vertices", bytemuck::cast_slice(&vertices), usage)?;
-        let usage = vk::BufferUsageFlags::INDEX_BUFFER;
+        let usage = vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
         let indices = Buffer::with_data(gpu, "indices", bytemuck::cast_slice(&indices), usage)?;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let materials =

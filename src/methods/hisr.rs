@@ -147,6 +147,9 @@ impl Descriptor for HisrMethod {
     fn uses_multires(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     fn check(&self, s: &RenderSettings) -> Result<()> {
         let top = s.rsm_top_level();
         let (start, max) = (START_LEVEL.get(s), MAX_DEPTH.get(s));

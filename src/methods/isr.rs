@@ -57,6 +57,9 @@ impl Descriptor for IsrMethod {
     fn uses_multires(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     fn check(&self, s: &RenderSettings) -> Result<()> {
         let (base, r) = (BASE.get(s), s.rsm_resolution);
         if base > r {

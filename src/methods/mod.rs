@@ -29,6 +29,7 @@ pub mod vpls;
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
 use crate::multires::{self, MultiresBuffer};
+use crate::passes::visibility_grid;
 use crate::settings::params::AnyParam;
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
@@ -80,6 +81,20 @@ pub trait Descriptor: Sync {
     /// check and uniforms then come with it (`vpls`), and its bench sweep
     /// and label default to the VPL count's.
     fn reads_regular_vpls(&self) -> bool {
+        false
+    }
+
+    /// Whether it evaluates the patch formula (`patch_irradiance`,
+    /// `shaders/vpl.glsl`) and so takes its visibility term:
+    /// `--visibility` and `--visibility-grid` then come with it, the voxel
+    /// grid's memory and uniforms too (`passes::visibility_grid`).
+    fn reads_visibility(&self) -> bool {
+        false
+    }
+
+    /// Whether `--visibility exact` (the CPU limit) applies to it: the dense
+    /// reference only.
+    fn takes_exact_visibility(&self) -> bool {
         false
     }
 
@@ -198,8 +213,18 @@ pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyPar
     } else {
         &[]
     };
+    let visibility: &[&dyn AnyParam] = if d.reads_visibility() {
+        visibility_grid::PARAMS
+    } else {
+        &[]
+    };
     let own = d.params().iter().flat_map(|g| g.iter().copied());
-    multires.iter().chain(regular).copied().chain(own)
+    multires
+        .iter()
+        .chain(regular)
+        .chain(visibility)
+        .copied()
+        .chain(own)
 }
 
 /// Bytes of GPU memory `d`'s resources take for `s`, its capabilities' included.
@@ -209,7 +234,11 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
     } else {
         0
     };
-    multires + d.memory(s)
+    // The grid is made for the run whenever `--visibility voxels` is set
+    // (the viewer may switch to a method that reads it), so it counts
+    // whatever the method.
+    let grid = visibility_grid::memory(s);
+    multires + grid + d.memory(s)
 }
 
 /// Writes `d`'s fields of the run uniforms for `s`: its capabilities', then
@@ -220,6 +249,9 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
     }
     if d.reads_regular_vpls() {
         vpls::RegularVpls::of(s).write_uniforms(s, u);
+    }
+    if d.reads_visibility() {
+        visibility_grid::write_uniforms(s, u);
     }
     d.write_uniforms(s, u);
 }
@@ -253,6 +285,9 @@ pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
     }
     if d.reads_regular_vpls() {
         vpls::check(s)?;
+    }
+    if d.reads_visibility() {
+        visibility_grid::check(s, d.key().name(), d.takes_exact_visibility())?;
     }
     d.check(s)?;
     Ok(d)

@@ -35,6 +35,9 @@ impl Descriptor for MultiresGatherMethod {
     fn reads_regular_vpls(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     /// The VPL list.
     fn memory(&self, s: &RenderSettings) -> u64 {
         RegularVpls::of(s).count as u64 * std::mem::size_of::<LightPatch>() as u64

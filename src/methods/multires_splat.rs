@@ -39,6 +39,9 @@ impl Descriptor for MultiresSplatMethod {
     fn reads_regular_vpls(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     fn check(&self, s: &RenderSettings) -> Result<()> {
         if !multires::STENCIL.get(s) {
             bail!("--stencil off measures the stenciled gathers; multires-splat always splats through the stencil");

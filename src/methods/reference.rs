@@ -21,8 +21,9 @@ use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
+use crate::passes::visibility_grid;
 use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
-use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
+use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, RenderSettings};
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
@@ -42,44 +43,7 @@ pub const CHUNK: Param<u64> = Param {
     range: Range::at_least(1.0),
 };
 
-/// Which VPLs see which receivers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Visibility {
-    /// Every VPL sees every receiver it faces (the talk's model).
-    None,
-    /// One ray per receiver and VPL, on the CPU.
-    Exact,
-}
-
-impl Choices for Visibility {
-    const NAMES: &'static [(&'static str, &'static str)] = &[
-        (
-            "none",
-            "every VPL lights every receiver it faces, occluded or not (the talk's model)",
-        ),
-        (
-            "exact",
-            "a ray from each receiver to each VPL through the scene's BVH, on the CPU \
-             (slow: the limit the model can reach)",
-        ),
-    ];
-    fn index(self) -> usize {
-        self as usize
-    }
-    fn from_index(i: usize) -> Self {
-        [Visibility::None, Visibility::Exact][i]
-    }
-}
-
-pub const VISIBILITY: Param<Visibility> = Param {
-    name: "visibility",
-    help: "--method reference: whether VPLs are occluded on their way to a receiver \
-           (exact: the CPU limit, minutes at 256x256)",
-    default: DefaultValue::Fixed(Visibility::None),
-    range: Range::ANY,
-};
-
-const PARAMS: &[&dyn AnyParam] = &[&CHUNK, &VISIBILITY];
+const PARAMS: &[&dyn AnyParam] = &[&CHUNK];
 
 pub struct ReferenceMethod;
 
@@ -93,6 +57,14 @@ impl Descriptor for ReferenceMethod {
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
         // Its VPLs are every RSM texel: --vpls and --vpl-sampling do not apply.
         &[PARAMS]
+    }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
+    /// `--visibility exact`: the CPU gather of `visibility` replaces this
+    /// one's image after the frame.
+    fn takes_exact_visibility(&self) -> bool {
+        true
     }
     /// Many submissions a frame: seconds on lavapipe, not for a window.
     fn interactive(&self) -> bool {
@@ -137,7 +109,14 @@ impl Reference {
         )?;
         let total = RegularVpls::every_texel(s).count;
         let pixels = s.width as u64 * s.height as u64;
-        let per_chunk = (CHUNK.get(s).max(1) / pixels).clamp(1, total as u64) as u32;
+        let mut per_chunk = (CHUNK.get(s).max(1) / pixels).clamp(1, total as u64) as u32;
+        if visibility_grid::uses_voxels(s) {
+            // A fragment's marches through the grid within lavapipe's loop
+            // limit (`visibility_grid::LOOP_BUDGET`).
+            let most =
+                visibility_grid::LOOP_BUDGET / visibility_grid::LOOP_ITERATIONS_PER_EVALUATION;
+            per_chunk = per_chunk.min(most as u32);
+        }
         let chunks = (0..total.div_ceil(per_chunk))
             .map(|c| (c * per_chunk, ((c + 1) * per_chunk).min(total)))
             .collect();

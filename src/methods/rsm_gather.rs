@@ -29,6 +29,9 @@ impl Descriptor for RsmGatherMethod {
     fn reads_regular_vpls(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
         Some(RegularVpls::of(s).count as u64)
     }

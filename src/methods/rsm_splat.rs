@@ -62,6 +62,9 @@ impl Descriptor for RsmSplatMethod {
     fn reads_regular_vpls(&self) -> bool {
         true
     }
+    fn reads_visibility(&self) -> bool {
+        true
+    }
     fn params(&self) -> &'static [&'static [&'static dyn AnyParam]] {
         match self.restricted {
             false => &[],

@@ -104,6 +104,18 @@ impl<'g> Renderer<'g> {
             self.views.len(),
             self.state.instance_transforms.len(),
         )?;
+        // The grid is made with the run (the frame sets bind it).
+        let grid_in_use = reads_grid(descriptor, settings);
+        let grid = crate::passes::visibility_grid::GRID;
+        if grid_in_use
+            && (self.visibility_pass.is_none() || grid.get(settings) != grid.get(&self.settings))
+        {
+            bail!(
+                "the voxel visibility grid is made when the run starts: to use --visibility \
+                 voxels with --visibility-grid {}, start isr with them",
+                grid.get(settings)
+            );
+        }
         // The frames in flight were of the old method; their numbers go.
         self.wait_idle()?;
         let gpu = self.gpu;
@@ -137,6 +149,7 @@ impl<'g> Renderer<'g> {
             );
         })?;
         self.method = method;
+        self.grid_in_use = grid_in_use;
         self.run_uniforms.1 = values;
         self.settings = settings.clone();
         Ok(())

@@ -18,6 +18,7 @@ use crate::multires::MultiresBuffer;
 use crate::passes::light_sum::{LightSumPass, SumStep};
 use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::{self, RsmTreePass};
+use crate::passes::visibility_grid::{self, VisibilityGridPass};
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::readback::{self, MultiresReadback, Readback};
 use crate::scene::{FrameState, LightKind, Scene};
@@ -66,13 +67,13 @@ struct Slot<'g> {
 impl<'g> Slot<'g> {
     fn new(
         gpu: &'g Gpu,
-        run: &Buffer,
+        (run, grid): (&Buffer, &Buffer),
         instances: usize,
         views: usize,
         passes: u32,
     ) -> Result<Self> {
         let frames = (0..views)
-            .map(|_| FrameSet::new(gpu, run, instances))
+            .map(|_| FrameSet::new(gpu, run, grid, instances))
             .collect::<Result<Vec<_>>>()?;
         let profiler = Profiler::new(gpu, passes)?;
         let fence = unsafe {
@@ -135,6 +136,10 @@ pub struct Renderer<'g> {
     /// Renders only this view (tests look at one cube face's RSM).
     only_view: Option<usize>,
     light_sum: Option<LightSumPass>,
+    /// Pass `visibility-grid`, made when the run asks for `--visibility
+    /// voxels`, and whether the current method reads it (`grid_in_use`).
+    visibility_pass: Option<VisibilityGridPass>,
+    grid_in_use: bool,
     /// Point lights' layered cube RSM (made only when the scene has one).
     rsm_cube: Option<CubeRsmPass>,
     method: Box<dyn IndirectMethod>,
@@ -149,6 +154,9 @@ pub struct Renderer<'g> {
     frames_submitted: u32,
     /// The run uniforms' buffer, and the values it holds.
     run_uniforms: (Buffer, RunUniforms),
+    /// The voxel visibility grid every frame set binds (16 bytes without
+    /// `--visibility voxels`).
+    visibility_grid: Buffer,
     pub scene: SceneGpu,
     pub targets: Targets,
     _samplers: Samplers,
@@ -195,7 +203,8 @@ impl<'g> Renderer<'g> {
         // The slots' profilers are sized once the method says how many
         // submissions (repeated passes) its frames take, so the method comes
         // first, made with a provisional frame set of the same layout.
-        let first = FrameSet::new(gpu, &run_uniforms, scene.instances.len())?;
+        let visibility_grid = visibility_grid::grid_buffer(gpu, settings)?;
+        let first = FrameSet::new(gpu, &run_uniforms, &visibility_grid, scene.instances.len())?;
         let setup = Setup {
             gpu,
             frame: &first.set,
@@ -221,13 +230,20 @@ impl<'g> Renderer<'g> {
         } else {
             None
         };
+        // Made with `--visibility voxels` whatever the method, so that the
+        // viewer can switch to one that reads it; recorded only for those.
+        let grid_in_use = reads_grid(descriptor, settings);
+        let visibility_pass = match visibility_grid::uses_voxels(settings) {
+            true => Some(VisibilityGridPass::new(&setup, &visibility_grid)?),
+            false => None,
+        };
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
             .map(|_| {
                 Slot::new(
                     gpu,
-                    &run_uniforms,
+                    (&run_uniforms, &visibility_grid),
                     scene.instances.len(),
                     views.len(),
                     passes,
@@ -244,6 +260,8 @@ impl<'g> Renderer<'g> {
             views,
             only_view: None,
             light_sum,
+            visibility_pass,
+            grid_in_use,
             rsm_cube,
             method,
             rsm,
@@ -256,6 +274,7 @@ impl<'g> Renderer<'g> {
             next_slot: 0,
             frames_submitted: 0,
             run_uniforms: (run_uniforms, run_values),
+            visibility_grid,
             scene: scene_gpu,
             targets,
             _samplers: samplers,
@@ -306,7 +325,25 @@ impl<'g> Renderer<'g> {
     /// The frame uniforms of light view `v` (an index into `light_views`).
     pub fn view_uniforms(&self, v: usize) -> FrameUniforms {
         let bounds = relative(self.bounds, self.origin);
-        frame_uniforms(&self.state, &self.settings, &self.views[v], bounds)
+        let mut u = frame_uniforms(&self.state, &self.settings, &self.views[v], bounds);
+        u.visibility_grid = self.visibility_cube();
+        u
+    }
+
+    /// The voxel visibility grid's cube around the posed scene of the
+    /// current frame state (relative to the render origin).
+    pub fn visibility_cube(&self) -> [f32; 4] {
+        let boxes = self
+            .object_bounds
+            .iter()
+            .zip(&self.state.instance_transforms)
+            .map(|(b, m)| crate::view::transformed_box(m, *b));
+        visibility_grid::grid_cube(boxes, visibility_grid::GRID.get(&self.settings))
+    }
+
+    /// The voxel visibility grid's buffer (its bits, `shaders/visibility.glsl`).
+    pub fn visibility_grid(&self) -> Option<&Buffer> {
+        self.grid_in_use.then_some(&self.visibility_grid)
     }
 
     /// The RSMs each frame renders, in order.
@@ -420,6 +457,10 @@ impl<'g> Renderer<'g> {
             if i == 0 {
                 p.set_label(None);
                 self.gbuffer.record(&ctx(cmds[c], v), p);
+                // The posed scene's occupancy, shared by every light view.
+                if let Some(grid) = self.visibility_pass.as_ref().filter(|_| self.grid_in_use) {
+                    grid.record(&ctx(cmds[c], v), p);
+                }
                 p.set_label(labels[i].clone());
             }
             self.direct.record(&ctx(cmds[c], v), p);
@@ -654,6 +695,11 @@ fn check_run(
         AddedMemory { method, cube_rsm },
     )?;
     Ok(d)
+}
+
+/// Whether a run of `d` with `s` reads the voxel visibility grid.
+fn reads_grid(d: &dyn Descriptor, s: &RenderSettings) -> bool {
+    d.reads_visibility() && visibility_grid::uses_voxels(s)
 }
 
 /// The run uniforms of `s`: the shared fields, the RSM tree's, then the

@@ -1,0 +1,111 @@
+// Indirect visibility through the voxel occupancy grid (docs/algorithm.md
+// section 5, "Voxel visibility"): whether the segment from a receiver to a
+// light patch crosses an occupied cell. The grid is this frame's posed
+// scene, conservatively voxelized by visibility_grid.comp: N^3 finest cells
+// over the cube u.visibility_grid, and OR-levels k = 1.. of side N >> k
+// (a level-k cell is occupied iff one of its 8^k finest cells is), one bit
+// per cell, x fastest, level after level in one buffer.
+#ifndef VISIBILITY_GLSL
+#define VISIBILITY_GLSL
+#include "frame.glsl"
+
+layout(set = 0, binding = 3, std430) readonly buffer VisibilityGrid { uint visibility_bits[]; };
+
+// Words before level k: sum over i < k of (N >> i)^3 / 32 = (N^3 - (N >> k)^3) / 28
+// (a geometric sum of ratio 1/8; every level has at least 4^3 cells, so whole words).
+uint grid_level_offset(int k) {
+    uint n = uint(run.visibility_side);
+    uint m = n >> uint(k);
+    return (n * n * n - m * m * m) / 28u;
+}
+
+bool grid_occupied(int k, ivec3 c) {
+    int n = run.visibility_side >> k;
+    uint i = uint((c.z * n + c.y) * n + c.x);
+    return (visibility_bits[grid_level_offset(k) + (i >> 5u)] & (1u << (i & 31u))) != 0u;
+}
+
+// The parts of the segment nearer than this to either end's tangent plane
+// (in finest cells) are not marched: the cells a plane touches lie within a
+// cell's diagonal, sqrt(3), of it, so a point farther than that from the
+// receiver's (or the patch's) own plane is never in a cell that plane made
+// occupied. What it skips is a length of about 1.75 cells / cos: grazing
+// pairs skip most, and they are the ones the cosines weigh least.
+const float VISIBILITY_END_SKIP = 1.75;
+
+// Lavapipe (gallivm) ends every loop of a shader invocation once they have
+// run 65,535 iterations together, without a word: a fragment that gathers E
+// patches may take E (MAX_ITERATIONS + 1) iterations for the marches, so
+// each march is at most VISIBILITY_MAX_ITERATIONS iterations of
+// six cells entered or levels changed each (docs/algorithm.md section 5,
+// "Voxel visibility", has the bound per method). A march that has not ended
+// by then counts as visible.
+const int VISIBILITY_MAX_ITERATIONS = 13;
+
+// 1 if the segment xi -> xj crosses no occupied finest cell outside the two
+// ends' skipped parts, else 0. ni, nj: unit normals of the receiver and the
+// patch (the rise over each one's plane is where the contribution is not 0).
+// A hierarchical DDA: at each point, the coarsest level whose cell there is
+// empty is skipped whole (found from level 1 up); an occupied cell is entered one level finer; an
+// occupied finest cell blocks; after leaving a cell the march climbs a level
+// only where it also left the parent cell.
+float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
+    vec4 g = u.visibility_grid;
+    vec3 a = (xi - g.xyz) / g.w;  // in finest cells
+    vec3 d = (xj - xi) / g.w;
+    float rise_i = dot(d, ni);    // the patch's height over the receiver's plane
+    float rise_j = -dot(d, nj);   // the receiver's height over the patch's plane
+    float t0 = VISIBILITY_END_SKIP / max(rise_i, 1e-30);
+    float t1 = 1.0 - VISIBILITY_END_SKIP / max(rise_j, 1e-30);
+    // No zero components: the exit distances below stay finite and ordered.
+    vec3 ds = mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
+    vec3 inv = 1.0 / ds;
+    // Only the grid's inside holds occluders.
+    float side = float(run.visibility_side);
+    vec3 ta = -a * inv, tb = (vec3(side) - a) * inv;
+    vec3 tin = min(ta, tb), tout = max(ta, tb);
+    t0 = max(t0, max(tin.x, max(tin.y, tin.z)));
+    t1 = min(t1, min(tout.x, min(tout.y, tout.z)));
+    vec3 ahead = vec3(greaterThan(ds, vec3(0.0)));
+    float eps = 1e-3 / length(d);  // a thousandth of a cell along the segment
+    int top = run.visibility_levels - 1;
+    // Start one level up: the march starts near the receiver's surface,
+    // where the coarse cells are occupied (it climbs as it leaves parents).
+    int k = min(1, top);
+    float t = t0;
+    ivec3 last_cell = ivec3(run.visibility_side - 1);
+    float visible = 1.0;
+    bool going = t < t1;
+    // One cell entered or one level changed.
+#define VISIBILITY_STEP                                                              \
+    if (going) {                                                                     \
+        ivec3 f = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);               \
+        ivec3 c = ivec3(f.x >> k, f.y >> k, f.z >> k);                               \
+        if (grid_occupied(k, c)) {                                                   \
+            if (k == 0) {                                                            \
+                visible = 0.0;                                                       \
+                going = false;                                                       \
+            }                                                                        \
+            k -= 1;                                                                  \
+        } else {                                                                     \
+            vec3 far = ((vec3(c) + ahead) * float(1 << k) - a) * inv;                \
+            t = max(t, min(far.x, min(far.y, far.z))) + eps;                         \
+            going = t < t1;                                                          \
+            ivec3 n = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);           \
+            int up = k + 1;                                                          \
+            if (k < top && ivec3(n.x >> up, n.y >> up, n.z >> up) != c / 2) k = up;  \
+        }                                                                            \
+    }
+    for (int i = 0; i < VISIBILITY_MAX_ITERATIONS && going; ++i) {
+        VISIBILITY_STEP
+        VISIBILITY_STEP
+        VISIBILITY_STEP
+        VISIBILITY_STEP
+        VISIBILITY_STEP
+        VISIBILITY_STEP
+    }
+#undef VISIBILITY_STEP
+    return visible;
+}
+
+#endif

@@ -1,0 +1,138 @@
+#version 460
+// Pass visibility-grid (docs/algorithm.md section 5, "Voxel visibility"): the
+// occupancy grid of this frame's posed scene, one invocation per triangle of
+// one instance (placed by this frame's InstanceTransform). Every cell, at
+// every level, that the triangle touches gets its bit set with atomicOr, so
+// the result does not depend on the order triangles run in. Each level is
+// voxelized on its own (a level-k cell is a box of 2^k finest cells): a
+// triangle touches a coarse cell iff it touches one of its children, so this
+// is the OR of the finer level without a pass or a barrier between levels.
+//
+// The test is the separating-axis test of a triangle and a box (Akenine-Moller
+// 2001), made conservative by a small margin: the box's face normals come
+// from visiting only the cells of the triangle's bounding box, the
+// triangle's normal from visiting, in each column along the dominant axis of
+// the normal, only the cells the plane crosses over that column; the nine
+// axes edge x box-axis are tested per cell.
+//
+// Lavapipe ends a shader invocation's loops after 65,535 iterations
+// together, so one invocation covers one tile of VISIBILITY_TILE x
+// VISIBILITY_TILE columns (gl_GlobalInvocationID.y; levels no wider than a
+// tile are covered by tile 0 alone): at most 3 cells per column, since the
+// columns run along the normal's dominant axis.
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+layout(local_size_x = 64) in;
+
+// Cleared before the dispatch (visibility_grid.rs); layout in visibility.glsl.
+layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
+layout(set = 1, binding = 0, std430) readonly buffer Vertices { float vertex_data[]; };  // GpuVertex: 8 floats
+layout(set = 1, binding = 1, std430) readonly buffer Indices { uint index_data[]; };
+layout(push_constant) uniform Push { VisibilityGridPush draw; };
+
+// In cells: covers float error in the corners and faces the tests compare.
+const float MARGIN = 1e-3;
+
+// Columns per tile side (visibility_grid.rs dispatches (N / VISIBILITY_TILE)^2 tiles).
+const int VISIBILITY_TILE = 32;
+
+uint level_offset(int k) {
+    uint n = uint(run.visibility_side);
+    uint m = n >> uint(k);
+    return (n * n * n - m * m * m) / 28u;
+}
+
+vec3 vertex_position(uint index) {
+    uint v = uint(int(index) + draw.vertex_offset) * 8u;
+    return vec3(vertex_data[v], vertex_data[v + 1u], vertex_data[v + 2u]);
+}
+
+// Whether axis separates the triangle (vertices relative to the box centre)
+// from the box of half side h.
+bool separates(vec3 axis, vec3 v0, vec3 v1, vec3 v2, float h) {
+    float p0 = dot(axis, v0), p1 = dot(axis, v1), p2 = dot(axis, v2);
+    float r = h * (abs(axis.x) + abs(axis.y) + abs(axis.z));
+    return min(p0, min(p1, p2)) > r || max(p0, max(p1, p2)) < -r;
+}
+
+// The nine axes e x (x, y, z) of one edge e.
+bool edge_separates(vec3 e, vec3 v0, vec3 v1, vec3 v2, float h) {
+    return separates(vec3(0.0, -e.z, e.y), v0, v1, v2, h)
+        || separates(vec3(e.z, 0.0, -e.x), v0, v1, v2, h)
+        || separates(vec3(-e.y, e.x, 0.0), v0, v1, v2, h);
+}
+
+bool touches(ivec3 cell, vec3 a, vec3 b, vec3 c) {
+    vec3 centre = vec3(cell) + 0.5;
+    vec3 v0 = a - centre, v1 = b - centre, v2 = c - centre;
+    float h = 0.5 + MARGIN;
+    return !(edge_separates(b - a, v0, v1, v2, h) || edge_separates(c - b, v0, v1, v2, h)
+             || edge_separates(a - c, v0, v1, v2, h));
+}
+
+void set_cell(int k, ivec3 cell) {
+    int n = run.visibility_side >> k;
+    uint i = uint((cell.z * n + cell.y) * n + cell.x);
+    atomicOr(visibility_bits[level_offset(k) + (i >> 5u)], 1u << (i & 31u));
+}
+
+// Marks the cells of level k (side n) the triangle a, b, c (in level-k cells) touches.
+void mark(int k, vec3 a, vec3 b, vec3 c) {
+    int n = run.visibility_side >> k;
+    vec3 lo = min(a, min(b, c)) - MARGIN, hi = max(a, max(b, c)) + MARGIN;
+    if (any(lessThan(hi, vec3(0.0))) || any(greaterThanEqual(lo, vec3(float(n))))) return;
+    ivec3 clo = clamp(ivec3(floor(lo)), ivec3(0), ivec3(n - 1));
+    ivec3 chi = clamp(ivec3(floor(hi)), ivec3(0), ivec3(n - 1));
+    vec3 nrm = cross(b - a, c - a);
+    vec3 an = abs(nrm);
+    // w: the normal's dominant axis; u, v the other two. The plane is
+    // w = (dp - nrm_u u - nrm_v v) / nrm_w.
+    int w = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    int ua = (w + 1) % 3, va = (w + 2) % 3;
+    // This invocation's tile of (u, v) columns.
+    int tiles = max(n / VISIBILITY_TILE, 1);
+    int tile = int(gl_GlobalInvocationID.y);
+    if (tile >= tiles * tiles) return;
+    ivec2 t0 = ivec2(tile % tiles, tile / tiles) * VISIBILITY_TILE;
+    clo[ua] = max(clo[ua], t0.x);
+    clo[va] = max(clo[va], t0.y);
+    chi[ua] = min(chi[ua], t0.x + VISIBILITY_TILE - 1);
+    chi[va] = min(chi[va], t0.y + VISIBILITY_TILE - 1);
+    float dp = dot(nrm, a);
+    float su = -nrm[ua] / nrm[w], sv = -nrm[va] / nrm[w], s0 = dp / nrm[w];
+    for (int cu = clo[ua]; cu <= chi[ua]; ++cu) {
+        for (int cv = clo[va]; cv <= chi[va]; ++cv) {
+            // The plane's w over the column [cu, cu + 1] x [cv, cv + 1]:
+            // linear, so its extremes are at the corners.
+            float w00 = s0 + su * float(cu) + sv * float(cv);
+            float wlo = w00 + min(su, 0.0) + min(sv, 0.0) - MARGIN;
+            float whi = w00 + max(su, 0.0) + max(sv, 0.0) + MARGIN;
+            int w0 = max(clo[w], int(floor(wlo))), w1 = min(chi[w], int(floor(whi)));
+            for (int cw = w0; cw <= w1; ++cw) {
+                ivec3 cell;
+                cell[ua] = cu;
+                cell[va] = cv;
+                cell[w] = cw;
+                if (touches(cell, a, b, c)) set_cell(k, cell);
+            }
+        }
+    }
+}
+
+void main() {
+    uint t = gl_GlobalInvocationID.x;
+    if (t >= draw.triangles) return;
+    uint first = draw.first_index + 3u * (draw.first_triangle + t);
+    mat4 m = transforms[draw.instance].world_from_object;
+    vec4 g = u.visibility_grid;
+    vec3 a = ((m * vec4(vertex_position(index_data[first]), 1.0)).xyz - g.xyz) / g.w;
+    vec3 b = ((m * vec4(vertex_position(index_data[first + 1u]), 1.0)).xyz - g.xyz) / g.w;
+    vec3 c = ((m * vec4(vertex_position(index_data[first + 2u]), 1.0)).xyz - g.xyz) / g.w;
+    vec3 nrm = cross(b - a, c - a);
+    // A triangle without area hides nothing (and has no plane).
+    if (!(dot(nrm, nrm) > 1e-20)) return;
+    for (int k = 0; k < run.visibility_levels; ++k) {
+        float scale = 1.0 / float(1 << k);
+        mark(k, a * scale, b * scale, c * scale);
+    }
+}

@@ -1,0 +1,323 @@
+//! Indirect visibility (issue 25; docs/algorithm.md section 5, "Exact indirect
+//! visibility" and "Voxel visibility"): the parameters every gathering method
+//! reads (`--visibility`, `--visibility-grid`), and pass `visibility-grid`,
+//! which builds the voxel occupancy grid of this frame's posed scene.
+//!
+//! The grid is one storage buffer, set 0 binding 3 of every pipeline (the
+//! frame set, `frame::FrameSet`): `shaders/visibility_grid.comp` writes it,
+//! the patch formula (`patch_irradiance`, `shaders/vpl.glsl`) of every
+//! gathering method reads it through `shaders/visibility.glsl`. Nothing is
+//! kept across frames: the pass clears it and voxelizes every instance's
+//! triangles, posed by this frame's transforms, into the cube
+//! [`grid_cube`] puts around them.
+//!
+//! Barriers (in `record`): the previous frame's readers (shaders of every
+//! stage, the readback copy) before the clear; the clear before the
+//! voxelization's atomics; the atomics before every later reader.
+
+use super::INDIRECT_COMPUTE;
+use crate::frame::{FrameContext, Setup};
+use crate::gpu_types::{self, RunUniforms, VisibilityGridPush};
+use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
+use crate::settings::RenderSettings;
+use crate::vk::barrier;
+use crate::vk::pipeline::{Binding, DescriptorSet, Pipeline};
+use crate::vk::profiler::Profiler;
+use crate::vk::{Buffer, Gpu};
+use anyhow::{bail, Result};
+use ash::vk;
+use glam::Vec3;
+use gpu_allocator::MemoryLocation;
+
+/// Which light patches see which receivers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// Every patch lights every receiver it faces (the talk's model).
+    None,
+    /// One ray per receiver and VPL, on the CPU (`reference` only).
+    Exact,
+    /// The segment marched through this frame's voxel occupancy grid, on the GPU.
+    Voxels,
+}
+
+impl Choices for Visibility {
+    const NAMES: &'static [(&'static str, &'static str)] = &[
+        (
+            "none",
+            "every light patch lights every receiver it faces, occluded or not (the talk's model)",
+        ),
+        (
+            "exact",
+            "--method reference only: a ray from each receiver to each VPL through the scene's \
+             BVH, on the CPU (slow: the limit the model can reach)",
+        ),
+        (
+            "voxels",
+            "the segment from receiver to light patch marched through a voxel occupancy grid \
+             of the posed scene, built on the GPU every frame (--visibility-grid)",
+        ),
+    ];
+    fn index(self) -> usize {
+        self as usize
+    }
+    fn from_index(i: usize) -> Self {
+        [Visibility::None, Visibility::Exact, Visibility::Voxels][i]
+    }
+}
+
+pub const VISIBILITY: Param<Visibility> = Param {
+    name: "visibility",
+    help: "Whether light patches are occluded on their way to a receiver: none, voxels (a \
+           grid built every frame on the GPU), or exact (--method reference: the CPU limit, \
+           minutes at 256x256)",
+    default: DefaultValue::Fixed(Visibility::None),
+    range: Range::ANY,
+};
+
+/// The finest cells per side of the voxel grid.
+pub const GRID: Param<u32> = Param {
+    name: "visibility-grid",
+    help: "--visibility voxels: finest cells per side of the occupancy grid, a power of 2 \
+           (the grid is a cube around the posed scene)",
+    default: DefaultValue::Fixed(64),
+    range: Range::powers_of(2, 16.0, 1024.0),
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&VISIBILITY, &GRID];
+
+/// The coarsest level has 4 x 4 x 4 cells (whole 32-bit words, and coarser
+/// levels would be occupied almost always).
+const COARSEST_SIDE: u32 = 4;
+
+/// Levels of a grid of side `n`: n, n/2, ..., 4.
+pub fn levels(n: u32) -> u32 {
+    n.ilog2() - COARSEST_SIDE.ilog2() + 1
+}
+
+/// Whether `s` asks for the voxel grid.
+pub fn uses_voxels(s: &RenderSettings) -> bool {
+    VISIBILITY.get(s) == Visibility::Voxels
+}
+
+/// Bytes of the grid of `s`: one bit per cell of every level (0 without
+/// `--visibility voxels`).
+pub fn memory(s: &RenderSettings) -> u64 {
+    match uses_voxels(s) {
+        true => grid_bytes(GRID.get(s)),
+        false => 0,
+    }
+}
+
+/// Bytes of a grid of side `n` with its OR-levels: about n^3 / 8 * 8 / 7.
+pub fn grid_bytes(n: u32) -> u64 {
+    (0..levels(n)).map(|k| (n as u64 >> k).pow(3) / 8).sum()
+}
+
+/// Checks for a method that reads the visibility: `exact` is the CPU limit
+/// of the dense reference only.
+pub fn check(s: &RenderSettings, method: &str, reads_exact: bool) -> Result<()> {
+    if VISIBILITY.get(s) == Visibility::Exact && !reads_exact {
+        bail!(
+            "--visibility exact is the CPU limit of --method reference only; --method {method} \
+             takes --visibility none or voxels"
+        );
+    }
+    Ok(())
+}
+
+/// The visibility fields of the run uniforms.
+pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
+    let n = GRID.get(s);
+    u.visibility = match VISIBILITY.get(s) {
+        Visibility::Voxels => gpu_types::VISIBILITY_VOXELS,
+        // Exact is applied on the CPU after the frame (`visibility`).
+        Visibility::None | Visibility::Exact => gpu_types::VISIBILITY_NONE,
+    };
+    u.visibility_side = n as i32;
+    u.visibility_levels = levels(n) as i32;
+}
+
+/// The grid's cube for a posed scene whose instances have the world boxes
+/// `boxes`: centred on their union, its side the union's largest extent and
+/// one and a half cells more on each side, `n` cells per side. Surfaces on
+/// the bounds then lie inside cells, along the largest extent in their
+/// middle: a plane on a face between two cells would make both occupied.
+/// xyz: its min corner; w: a cell's side.
+pub fn grid_cube(boxes: impl Iterator<Item = (Vec3, Vec3)>, n: u32) -> [f32; 4] {
+    let (lo, hi) = boxes
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        .unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    let extent = (hi - lo).max_element().max(1e-6);
+    let cell = extent / (n as f32 - 3.0);
+    let side = cell * n as f32;
+    let corner = (lo + hi) * 0.5 - Vec3::splat(side * 0.5);
+    [corner.x, corner.y, corner.z, cell]
+}
+
+/// The grid buffer of `s` (16 bytes when nothing reads it: set 0 binds it
+/// whatever the method).
+pub fn grid_buffer(gpu: &Gpu, s: &RenderSettings) -> Result<Buffer> {
+    Buffer::new(
+        gpu,
+        "visibility grid",
+        memory(s).max(16),
+        vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_DST
+            | vk::BufferUsageFlags::TRANSFER_SRC,
+        MemoryLocation::GpuOnly,
+    )
+}
+
+/// Lavapipe ends all loops of a shader invocation after 65,535 iterations
+/// together (gallivm's loop limiter), silently. A march through the grid
+/// takes at most `VISIBILITY_MAX_ITERATIONS` (13, `shaders/visibility.glsl`)
+/// iterations, its evaluation one more of the caller's loop and one to test
+/// the march's condition: this many per evaluation.
+pub const LOOP_ITERATIONS_PER_EVALUATION: u64 = 15;
+
+/// What a fragment may spend on loops there, with room for its other loops.
+pub const LOOP_BUDGET: u64 = 61_440;
+
+/// Triangles per dispatch: 64 per workgroup, at most 65,535 workgroups.
+const TRIANGLES_PER_DISPATCH: u32 = 64 * 65_535;
+
+/// Pass `visibility-grid`.
+pub struct VisibilityGridPass {
+    pipeline: Pipeline,
+    set: DescriptorSet,
+    /// The grid it clears and fills (bound in the frame set).
+    buffer: vk::Buffer,
+    bytes: u64,
+    /// Tiles of `TILE` x `TILE` columns a triangle's invocations split it into.
+    tiles: u32,
+}
+
+/// Columns per tile side of the voxelization (`VISIBILITY_TILE` in
+/// `shaders/visibility_grid.comp`): one invocation covers one tile of one
+/// triangle at every level, within lavapipe's loop limit.
+pub const TILE: u32 = 32;
+
+impl VisibilityGridPass {
+    /// For the grid `grid` (bound as set 0 binding 3 of `setup.frame`).
+    pub fn new(setup: &Setup, grid: &Buffer) -> Result<Self> {
+        let scene = setup.scene;
+        let set = DescriptorSet::new(
+            setup.gpu,
+            "visibility-grid",
+            &[
+                Binding::storage("Vertices", &scene.vertices),
+                Binding::storage("Indices", &scene.indices),
+            ],
+        )?;
+        let pipeline = Pipeline::compute(
+            setup.gpu,
+            "visibility-grid",
+            "visibility_grid.comp",
+            &[setup.frame, &set],
+            std::mem::size_of::<VisibilityGridPush>() as u32,
+            &[],
+        )?;
+        Ok(Self {
+            pipeline,
+            set,
+            buffer: grid.buffer,
+            bytes: memory(setup.settings),
+            tiles: (GRID.get(setup.settings) / TILE).max(1).pow(2),
+        })
+    }
+
+    /// Clears the grid and voxelizes every instance into it.
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        profiler.pass(gpu, cmd, "visibility-grid", INDIRECT_COMPUTE, || unsafe {
+            // The previous frame's gathers (and readback) read it before it
+            // is cleared; the clear comes before the atomics.
+            barrier::zero_buffer(
+                gpu,
+                cmd,
+                self.buffer,
+                self.bytes,
+                (barrier::READERS, vk::AccessFlags2::NONE),
+                (vk::PipelineStageFlags2::COMPUTE_SHADER, rw),
+            );
+            self.pipeline.bind(
+                gpu,
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                &[ctx.frame_set, self.set.set],
+            );
+            for draw in &ctx.scene.draws {
+                let triangles = draw.index_count / 3;
+                let mut first = 0;
+                while first < triangles {
+                    let n = (triangles - first).min(TRIANGLES_PER_DISPATCH);
+                    // x: 64 triangles per workgroup; y: the column tiles.
+                    let push = VisibilityGridPush {
+                        first_index: draw.first_index,
+                        vertex_offset: draw.vertex_offset,
+                        instance: draw.push.instance,
+                        first_triangle: first,
+                        triangles: n,
+                    };
+                    gpu.device.cmd_push_constants(
+                        cmd,
+                        self.pipeline.layout,
+                        vk::ShaderStageFlags::COMPUTE,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    gpu.device.cmd_dispatch(cmd, n.div_ceil(64), self.tiles, 1);
+                    first += n;
+                }
+            }
+            // Every later reader: the patch formula in fragment shaders (and
+            // any stage), the readback copy.
+            barrier::memory(
+                gpu,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                barrier::READERS,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::TRANSFER_READ,
+            );
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_and_bytes() {
+        assert_eq!(levels(16), 3);
+        assert_eq!(levels(64), 5);
+        // 64^3 / 8 + 32^3 / 8 + 16^3 / 8 + 8^3 / 8 + 4^3 / 8 bytes.
+        assert_eq!(grid_bytes(64), 32768 + 4096 + 512 + 64 + 8);
+        // The shader's offset formula: words before level k are (n^3 - m^3) / 28.
+        for n in [16u64, 64, 1024] {
+            let mut words = 0;
+            for k in 0..levels(n as u32) {
+                let m = n >> k;
+                assert_eq!(words, (n * n * n - m * m * m) / 28, "{n} {k}");
+                words += m * m * m / 32;
+            }
+            assert_eq!(words * 4, grid_bytes(n as u32));
+        }
+    }
+
+    #[test]
+    fn the_cube_holds_the_boxes_with_a_cell_to_spare() {
+        let boxes = [
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 1.0)),
+            (Vec3::new(-1.0, 0.5, 0.0), Vec3::new(0.0, 1.0, 3.0)),
+        ];
+        let [x, y, z, cell] = grid_cube(boxes.into_iter(), 64);
+        let lo = Vec3::new(x, y, z);
+        let hi = lo + Vec3::splat(cell * 64.0);
+        assert!((cell - 3.0 / 61.0).abs() < 1e-6);
+        assert!(lo.cmple(Vec3::new(-1.0, 0.0, 0.0) - cell * 1.49).all());
+        assert!(hi.cmpge(Vec3::new(1.0, 2.0, 3.0) + cell * 1.49).all());
+    }
+}
