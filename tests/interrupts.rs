@@ -38,6 +38,7 @@ fn sequence(dir: &Path) -> Running {
         .args(["--frames", "20", "--sequence", "seq"])
         .env("ISR_TEST_WRITE_PAUSE_MS", "300")
         .hang_guard(Duration::from_secs(120))
+        .default_signals()
         .spawn()
 }
 

@@ -6,24 +6,7 @@ mod common;
 
 use common::*;
 use isr::bench::truth::{trace, ShadowMaps};
-use isr::scene::cornell::cornell_box;
 use isr::scene::Scene;
-
-/// The Cornell box at rest with its blocks, or without them (a convex room:
-/// every surface sees every other, so visibility changes nothing).
-fn room(blocks: bool) -> Scene {
-    let mut s = cornell_box();
-    s.animation = None;
-    if !blocks {
-        let keep: Vec<bool> = s
-            .meshes
-            .iter()
-            .map(|m| !m.name.ends_with("block"))
-            .collect();
-        s.instances.retain(|i| keep[i.mesh]);
-    }
-    s
-}
 
 /// The dense reference of `scene` against its truth at noise `target`:
 /// (relative RMSE, the truth's spp and measured noise, fraction left out).
@@ -42,7 +25,7 @@ fn model_error(gpu: &isr::vk::Gpu, scene: &Scene, target: f64) -> (f64, u32, f64
 #[test]
 fn the_truth_measures_its_own_noise() {
     let gpu = gpu();
-    let scene = room(true);
+    let scene = cornell_at_rest(true);
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu, &scene, &settings, 1);
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
@@ -71,7 +54,7 @@ fn the_dense_reference_meets_the_truth_where_nothing_occludes_and_parts_where_bl
     let gpu = gpu();
     let target = 0.05;
     let [(open, open_noise), (blocked, blocked_noise)] = [false, true].map(|blocks| {
-        let (e, spp, noise, left_out) = model_error(&gpu, &room(blocks), target);
+        let (e, spp, noise, left_out) = model_error(&gpu, &cornell_at_rest(blocks), target);
         let model = (e * e - noise * noise).max(0.0).sqrt();
         println!(
             "blocks {blocks}: {e:.4} from the truth ({spp} spp, noise {noise:.4}, \

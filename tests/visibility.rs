@@ -296,21 +296,6 @@ fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
     s
 }
 
-/// The Cornell box at rest, without its blocks (a convex room) or with them.
-fn cornell(blocks: bool) -> Scene {
-    let mut s = cornell_box();
-    s.animation = None;
-    if !blocks {
-        let keep: Vec<bool> = s
-            .meshes
-            .iter()
-            .map(|m| !m.name.ends_with("block"))
-            .collect();
-        s.instances.retain(|i| keep[i.mesh]);
-    }
-    s
-}
-
 /// The gathering methods, each small.
 const GATHERS: [&str; 8] = [
     "rsm-gather",
@@ -332,7 +317,7 @@ fn voxel_visibility_changes_nothing_in_the_empty_box() {
     // wall within a cell of it (docs/algorithm.md section 5, "Voxel
     // visibility"): it narrows as the grid refines.
     let gpu = gpu();
-    let room = cornell(false);
+    let room = cornell_at_rest(false);
     let n = GRID.get(&RenderSettings::default());
     for method in ["reference", "rsm-gather", "multires-gather", "hisr"] {
         let s = small_params(sized(method, 64, 64, 64), 1024, 64, 1 << 24);
@@ -448,7 +433,7 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
     // limit (the CPU's rays) falls as the grid refines, and against the
     // path-traced truth it is well below the error without visibility.
     let gpu = gpu();
-    let scene = cornell(true);
+    let scene = cornell_at_rest(true);
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu, &scene, &settings, 1);
     let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
@@ -499,7 +484,7 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
 #[test]
 fn every_gathering_method_takes_the_grid_and_validation_stays_clean() {
     let gpu = validating_gpu();
-    let scene = cornell(true);
+    let scene = cornell_at_rest(true);
     for method in GATHERS {
         let s = small_params(sized(method, 32, 32, 32), 64, 16, 1 << 20);
         let without = render(&gpu, &scene, &s, 1).readback;
@@ -532,7 +517,7 @@ fn the_grid_marks_the_boxs_walls_and_leaves_its_inside_empty() {
     // cell is occupied iff a wall passes through it, and each coarser
     // level is the OR of the finer one.
     let gpu = gpu();
-    let room = cornell(false);
+    let room = cornell_at_rest(false);
     let n = 16u32;
     let s = voxels(sized("reference", 16, 16, 16), n);
     let mut r = isr::renderer::Renderer::new(&gpu, &room, &s).unwrap();
@@ -671,7 +656,7 @@ fn a_method_switch_uses_the_grid_made_with_the_run_and_refuses_one_never_made() 
     // run whenever --visibility voxels is set, and used by the methods
     // that read it.
     let gpu = gpu();
-    let scene = cornell(true);
+    let scene = cornell_at_rest(true);
     let hisr = voxels(sized("hisr", 32, 32, 32), 32);
     let mut r =
         isr::renderer::Renderer::new(&gpu, &scene, &voxels(sized("none", 32, 32, 32), 32)).unwrap();

@@ -97,6 +97,26 @@ impl Isr {
         self
     }
 
+    /// The child starts with SIGINT, SIGTERM and SIGHUP at their default
+    /// actions, whatever this process inherited: a test run started in the
+    /// background of a shell has SIGINT ignored, which isr rightly keeps
+    /// (`cli::interrupt`), so a test of isr's own handling sets them.
+    #[cfg(unix)]
+    pub fn default_signals(mut self) -> Isr {
+        use std::os::unix::process::CommandExt as _;
+        // SAFETY: the closure only calls signal(), which is
+        // async-signal-safe, as pre_exec requires.
+        unsafe {
+            self.cmd.pre_exec(|| {
+                for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+                    libc::signal(s, libc::SIG_DFL);
+                }
+                Ok(())
+            });
+        }
+        self
+    }
+
     /// Runs to the end (or to the hang guard, which fails the test).
     pub fn run(self) -> Ran {
         self.spawn().wait()

@@ -261,6 +261,22 @@ pub fn box_sun() -> Light {
 }
 
 /// The Cornell box, still, lit by `lights`.
+/// The built-in box at rest with its blocks, or without them (a convex
+/// room: every surface sees every other, so visibility changes nothing).
+pub fn cornell_at_rest(blocks: bool) -> Scene {
+    let mut s = cornell_box();
+    s.animation = None;
+    if !blocks {
+        let keep: Vec<bool> = s
+            .meshes
+            .iter()
+            .map(|m| !m.name.ends_with("block"))
+            .collect();
+        s.instances.retain(|i| keep[i.mesh]);
+    }
+    s
+}
+
 pub fn cornell_with(lights: Vec<Light>) -> Scene {
     let mut s = cornell_box();
     s.animation = None;
