@@ -77,7 +77,10 @@ impl GatherPass {
                     vk::Format::UNDEFINED
                 },
                 stencil: stencil.then_some(StencilTest::EQUAL_ONE),
-                specialization: &[(0, source as i32)],
+                specialization: &[
+                    (0, source as i32),
+                    crate::passes::visibility_grid::specialization(setup.settings),
+                ],
                 ..Default::default()
             },
         )?;

@@ -86,6 +86,9 @@ impl MultiresSplatPass {
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::EQUAL_ONE),
                 blend: Blend::AdditiveAlphaMax,
+                specialization: &[crate::passes::visibility_grid::specialization(
+                    setup.settings,
+                )],
                 ..Default::default()
             },
         )?;

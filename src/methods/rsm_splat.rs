@@ -118,7 +118,10 @@ impl RsmSplat {
                 fragment_shader: "vpl_splat.frag",
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &[(0, restricted as i32)],
+                specialization: &[
+                    (0, restricted as i32),
+                    crate::passes::visibility_grid::specialization(setup.settings),
+                ],
                 ..Default::default()
             },
         )?;

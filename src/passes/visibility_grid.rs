@@ -99,6 +99,14 @@ pub fn uses_voxels(s: &RenderSettings) -> bool {
     VISIBILITY.get(s) == Visibility::Voxels
 }
 
+/// The specialization constant `VOXEL_VISIBILITY` (`shaders/vpl.glsl`) of
+/// every pipeline that evaluates the patch formula: the march is compiled
+/// only into runs with the grid (a uniform branch around it slowed every
+/// gather on lavapipe). Shaders without the constant ignore the entry.
+pub fn specialization(s: &RenderSettings) -> (u32, i32) {
+    (10, uses_voxels(s) as i32)
+}
+
 /// Bytes of the grid of `s`: one bit per cell of every level (0 without
 /// `--visibility voxels`).
 pub fn memory(s: &RenderSettings) -> u64 {
