@@ -627,19 +627,25 @@ pub fn cuboid(center: Vec3, size: Vec3, yaw: f32) -> (Vec<GpuVertex>, Vec<u32>) 
 }
 
 /// Face normals accumulated per vertex, for primitives without NORMAL.
-pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
-    // Positions scaled to about unit size first: at 1e18 m the cross product
-    // (1e36) would overflow when normalised. One scale for the whole mesh
-    // keeps the area weights' ratios.
+/// The factor that scales `vertices` to about unit size (1 when they are
+/// all at the origin or not finite), for cross products of their edges: at
+/// 1e18 m one (1e36) would overflow when normalised. One scale for the
+/// whole mesh keeps the area weights' ratios.
+pub(crate) fn unit_scale(vertices: &[GpuVertex]) -> f32 {
     let extent = vertices
         .iter()
         .flat_map(|v| v.position)
         .fold(0f32, |m, c| m.max(c.abs()));
-    let scale = if extent > 0.0 && extent.is_finite() {
+    if extent > 0.0 && extent.is_finite() {
         1.0 / extent
     } else {
         1.0
-    };
+    }
+}
+
+pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
+    // Positions scaled to about unit size first (`unit_scale`).
+    let scale = unit_scale(vertices);
     let mut acc = vec![Vec3::ZERO; vertices.len()];
     for t in indices.chunks_exact(3) {
         let p = |k: usize| Vec3::from(vertices[t[k] as usize].position) * scale;

@@ -27,15 +27,7 @@ const MAX_CLUSTERS: usize = 8;
 /// position's faces fall into clusters. Returns the new vertices and indices.
 pub fn crease_normals(vertices: &[GpuVertex], indices: &[u32]) -> (Vec<GpuVertex>, Vec<u32>) {
     // Positions scaled to about unit size, as `compute_normals` does.
-    let extent = vertices
-        .iter()
-        .flat_map(|v| v.position)
-        .fold(0f32, |m, c| m.max(c.abs()));
-    let scale = if extent > 0.0 && extent.is_finite() {
-        1.0 / extent
-    } else {
-        1.0
-    };
+    let scale = crate::scene::unit_scale(vertices);
     let triangles = indices.len() / 3;
     let face: Vec<Vec3> = indices
         .chunks_exact(3)
