@@ -12,6 +12,7 @@ pub mod rows;
 pub mod scenes;
 pub mod sweep;
 pub mod truth;
+mod truth_cache;
 
 use crate::readback::Readback;
 use crate::renderer::{FrameStats, Renderer};
@@ -554,11 +555,11 @@ fn run_scene(
             let out = r.readback()?;
             let truth = if with_truth {
                 let posed = state.pose(scene);
-                let t = frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
+                let t = truth_cache::frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
                 // Only the reference's row keeps the floor: minutes of rays
                 // when not cached, so not traced for a row already measured.
                 if ref_row && k == plan.frames / 2 {
-                    let exact = model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
+                    let exact = truth_cache::model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
                     model.floor = Some(metrics::relative_rmse(
                         &exact,
                         &t.image.indirect,
@@ -816,101 +817,4 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         gpu_memory_bytes: None,
         truth: Default::default(),
     }
-}
-
-/// The dense reference's indirect image of frame `k` of `spec` with exact
-/// visibility (`visibility::with_exact_visibility`; `out` is the frame `r`
-/// rendered), cached beside the truth (`truth/SCENE/exact-K.exr`) as it
-/// takes minutes on a CPU.
-fn model_floor(
-    plan: &Plan,
-    spec: &SceneSpec,
-    k: u32,
-    posed: &Scene,
-    r: &mut Renderer,
-    out: &Readback,
-    bar: &indicatif::ProgressBar,
-) -> Result<Vec<[f32; 4]>> {
-    let path = plan
-        .out_dir
-        .join("truth")
-        .join(&spec.name)
-        .join(format!("exact-{k}.exr"));
-    let time = frame_time(spec, k);
-    if let Some(cached) = truth::cached_exact(&path, out, time, plan.base.rsm_resolution) {
-        return Ok(cached);
-    }
-    let message = |done: usize, rows: usize| {
-        bar.set_message(format!(
-            "{}: the reference with exact visibility, frame {}: row {done}/{rows}",
-            spec.name,
-            k + 1
-        ))
-    };
-    let exact = crate::visibility::with_exact_visibility(r, posed, out.clone(), 1.0, message)?;
-    truth::write_exact(&path, &exact, time, plan.base.rsm_resolution)?;
-    if bar.is_hidden() {
-        eprintln!(
-            "{}: the reference with exact visibility at frame {}",
-            spec.name,
-            k + 1
-        );
-    }
-    Ok(exact.indirect)
-}
-
-/// The path-traced truth of frame `k` of `spec` at the run's noise target,
-/// cached in the run's folder (`truth/SCENE/frame-K.exr`, with a note of
-/// its samples and noise), compared on the pixels of `g` (the reference's
-/// G-buffer, whose RSMs `r` holds) away from edges.
-fn frame_truth(
-    plan: &Plan,
-    spec: &SceneSpec,
-    k: u32,
-    posed: &Scene,
-    r: &Renderer,
-    g: &Readback,
-    bar: &indicatif::ProgressBar,
-) -> Result<truth::Truth> {
-    let key = truth::FrameKey {
-        time: frame_time(spec, k),
-        target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
-        seed: k as u64 + 1,
-    };
-    let path = plan
-        .out_dir
-        .join("truth")
-        .join(&spec.name)
-        .join(format!("frame-{k}.exr"));
-    let shadows = truth::ShadowMaps::new(
-        r.light_views(),
-        r.render_origin(),
-        plan.base.rsm_resolution,
-        plan.base.pcf_radius,
-    );
-    let message = |spp: u32, noise: f64| {
-        bar.set_message(format!(
-            "{}: path-traced truth, frame {}/{}: {spp} spp, noise {:.1}%",
-            spec.name,
-            k + 1,
-            plan.frames,
-            100.0 * noise
-        ))
-    };
-    message(0, f64::NAN);
-    let t = truth::frame_truth(&path, posed, g, &shadows, key, message)
-        .with_context(|| format!("the path-traced truth of {} frame {k}", spec.name))?;
-    if bar.is_hidden() {
-        // No terminal (a log, CI): a line per frame, as per row.
-        eprintln!(
-            "{}: path-traced truth of frame {}/{}: {} spp, noise {:.4}, {:.1}% of pixels left out",
-            spec.name,
-            k + 1,
-            plan.frames,
-            t.spp,
-            t.noise,
-            100.0 * t.mask.left_out()
-        );
-    }
-    Ok(t)
 }

@@ -1,0 +1,252 @@
+//! The path-traced truth and the exact-visibility floor of each bench frame
+//! (docs/algorithm.md section 6.6), cached in the run's folder
+//! (`truth/SCENE/frame-K.exr` and `exact-K.exr`, each with a JSON note) so
+//! that a run that stops resumes without tracing them again.
+
+use super::truth::{self, trace, truth_mask, ShadowMaps, Truth};
+use super::{frame_time, Plan, SceneSpec};
+use crate::readback::Readback;
+use crate::renderer::Renderer;
+use crate::scene::Scene;
+use anyhow::{Context as _, Result};
+use std::path::Path;
+
+/// The dense reference's indirect image of frame `k` of `spec` with exact
+/// visibility (`visibility::with_exact_visibility`; `out` is the frame `r`
+/// rendered), cached beside the truth (`truth/SCENE/exact-K.exr`) as it
+/// takes minutes on a CPU.
+pub(super) fn model_floor(
+    plan: &Plan,
+    spec: &SceneSpec,
+    k: u32,
+    posed: &Scene,
+    r: &mut Renderer,
+    out: &Readback,
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<[f32; 4]>> {
+    let path = plan
+        .out_dir
+        .join("truth")
+        .join(&spec.name)
+        .join(format!("exact-{k}.exr"));
+    let time = frame_time(spec, k);
+    if let Some(cached) = cached_exact(&path, out, time, plan.base.rsm_resolution) {
+        return Ok(cached);
+    }
+    let message = |done: usize, rows: usize| {
+        bar.set_message(format!(
+            "{}: the reference with exact visibility, frame {}: row {done}/{rows}",
+            spec.name,
+            k + 1
+        ))
+    };
+    let exact = crate::visibility::with_exact_visibility(r, posed, out.clone(), 1.0, message)?;
+    write_exact(&path, &exact, time, plan.base.rsm_resolution)?;
+    if bar.is_hidden() {
+        eprintln!(
+            "{}: the reference with exact visibility at frame {}",
+            spec.name,
+            k + 1
+        );
+    }
+    Ok(exact.indirect)
+}
+
+/// The path-traced truth of frame `k` of `spec` at the run's noise target,
+/// cached in the run's folder (`truth/SCENE/frame-K.exr`, with a note of
+/// its samples and noise), compared on the pixels of `g` (the reference's
+/// G-buffer, whose RSMs `r` holds) away from edges.
+pub(super) fn frame_truth(
+    plan: &Plan,
+    spec: &SceneSpec,
+    k: u32,
+    posed: &Scene,
+    r: &Renderer,
+    g: &Readback,
+    bar: &indicatif::ProgressBar,
+) -> Result<truth::Truth> {
+    let key = FrameKey {
+        time: frame_time(spec, k),
+        target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
+        seed: k as u64 + 1,
+    };
+    let path = plan
+        .out_dir
+        .join("truth")
+        .join(&spec.name)
+        .join(format!("frame-{k}.exr"));
+    let shadows = truth::ShadowMaps::new(
+        r.light_views(),
+        r.render_origin(),
+        plan.base.rsm_resolution,
+        plan.base.pcf_radius,
+    );
+    let message = |spp: u32, noise: f64| {
+        bar.set_message(format!(
+            "{}: path-traced truth, frame {}/{}: {spp} spp, noise {:.1}%",
+            spec.name,
+            k + 1,
+            plan.frames,
+            100.0 * noise
+        ))
+    };
+    message(0, f64::NAN);
+    let t = traced_or_cached(&path, posed, g, &shadows, key, message)
+        .with_context(|| format!("the path-traced truth of {} frame {k}", spec.name))?;
+    if bar.is_hidden() {
+        // No terminal (a log, CI): a line per frame, as per row.
+        eprintln!(
+            "{}: path-traced truth of frame {}/{}: {} spp, noise {:.4}, {:.1}% of pixels left out",
+            spec.name,
+            k + 1,
+            plan.frames,
+            t.spp,
+            t.noise,
+            100.0 * t.mask.left_out()
+        );
+    }
+    Ok(t)
+}
+
+/// What a cached truth records beside its image (`FILE.json`).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CacheNote {
+    width: u32,
+    height: u32,
+    time: f32,
+    target: f64,
+    spp: u32,
+    noise: f64,
+}
+
+/// The layer `name` of the EXR `image` as RGBA pixels (alpha 1).
+fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<Vec<[f32; 4]>> {
+    use exr::prelude::FlatSamples;
+    let layer = image.layer_data.iter().find(|l| {
+        l.attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string())
+            .as_deref()
+            == Some(name)
+    })?;
+    let channel = |c: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.to_string() == c)
+            .and_then(|ch| match &ch.sample_data {
+                FlatSamples::F32(v) if v.len() == pixels => Some(v.clone()),
+                _ => None,
+            })
+    };
+    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
+}
+
+/// A truth traced before for this frame (`path` and its note), if its size
+/// and time match and it was traced for this noise target or measured under
+/// it; anything else is traced again.
+fn cached(path: &Path, g: &Readback, time: f32, target: f64) -> Option<(Readback, u32, f64)> {
+    let note: CacheNote =
+        serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    // A truth traced for a tighter target serves a looser one as it is.
+    if (note.width, note.height) != (g.width, g.height)
+        || note.time != time
+        || !(note.target == target || note.noise <= target)
+    {
+        return None;
+    }
+    let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
+    let n = (g.width * g.height) as usize;
+    let mut r = g.clone();
+    r.direct = layer(&image, "direct", n)?;
+    r.indirect = layer(&image, "indirect", n)?;
+    r.final_radiance = layer(&image, "final", n)?;
+    Some((r, note.spp, note.noise))
+}
+
+/// Which truth of a scene a bench frame needs: its animation time, the
+/// noise target, and the seed of its first samples.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameKey {
+    pub time: f32,
+    pub target: f64,
+    pub seed: u64,
+}
+
+/// The truth of one bench frame: read from `path` when traced before for
+/// the same size and time, to this noise target or under it, else traced (see [`trace`]) and written
+/// there (an EXR of the path tracer's layers and a JSON note), so that a
+/// run that stops resumes without tracing it again.
+fn traced_or_cached(
+    path: &Path,
+    posed: &crate::scene::Scene,
+    g: &Readback,
+    shadows: &ShadowMaps,
+    key: FrameKey,
+    progress: impl Fn(u32, f64),
+) -> anyhow::Result<Truth> {
+    let FrameKey { time, target, seed } = key;
+    if let Some((image, spp, noise)) = cached(path, g, time, target) {
+        let mask = truth_mask(g, &image.direct, shadows);
+        return Ok(Truth {
+            image,
+            mask,
+            spp,
+            noise,
+        });
+    }
+    let truth = trace(posed, g, shadows, target, seed, progress);
+    crate::output::write_exr(path, &truth.image)?;
+    let note = CacheNote {
+        width: g.width,
+        height: g.height,
+        time,
+        target,
+        spp: truth.spp,
+        noise: truth.noise,
+    };
+    crate::output::write_text(
+        &path.with_extension("json"),
+        &serde_json::to_string_pretty(&note)?,
+    )?;
+    Ok(truth)
+}
+
+/// What a cached exact-visibility reference records beside its image.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ExactNote {
+    width: u32,
+    height: u32,
+    time: f32,
+    rsm: u32,
+}
+
+/// The indirect image of an exact-visibility reference written before for
+/// this frame (`path` and its note), if its size, time and RSM match.
+fn cached_exact(path: &Path, g: &Readback, time: f32, rsm: u32) -> Option<Vec<[f32; 4]>> {
+    let note: ExactNote =
+        serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    if (note.width, note.height, note.rsm) != (g.width, g.height, rsm) || note.time != time {
+        return None;
+    }
+    let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
+    layer(&image, "indirect", (g.width * g.height) as usize)
+}
+
+/// Writes an exact-visibility reference frame for [`cached_exact`].
+fn write_exact(path: &Path, r: &Readback, time: f32, rsm: u32) -> anyhow::Result<()> {
+    crate::output::write_exr(path, r)?;
+    let note = ExactNote {
+        width: r.width,
+        height: r.height,
+        time,
+        rsm,
+    };
+    crate::output::write_text(
+        &path.with_extension("json"),
+        &serde_json::to_string_pretty(&note)?,
+    )
+}
