@@ -261,6 +261,35 @@ pub fn box_sun() -> Light {
 }
 
 /// The Cornell box, still, lit by `lights`.
+/// A horizontal disc of radius `r` at height `y`, centred on the y axis,
+/// of material `m` (the visibility tests' occluder).
+pub fn disc(s: &mut Scene, m: usize, y: f32, r: f32) {
+    let segments = 64;
+    let vertex = |p: Vec3| isr::scene::GpuVertex {
+        position: p.to_array(),
+        normal: [0.0, 1.0, 0.0],
+        uv: [0.0; 2],
+    };
+    let mut v = vec![vertex(Vec3::new(0.0, y, 0.0))];
+    let mut i = vec![];
+    for k in 0..segments {
+        let a = k as f32 / segments as f32 * std::f32::consts::TAU;
+        v.push(vertex(Vec3::new(r * a.cos(), y, r * a.sin())));
+        i.extend([0, 1 + k, 1 + (k + 1) % segments]);
+    }
+    s.add_mesh("disc", v, i, m);
+}
+
+/// A VPL at `p` facing down (the visibility tests' light).
+pub fn down(p: Vec3, flux: f32) -> isr::visibility::Vpl {
+    isr::visibility::Vpl {
+        position: p,
+        normal: -Vec3::Y,
+        flux: Vec3::splat(flux),
+        area: 1e-4,
+    }
+}
+
 /// The built-in box at rest with its blocks, or without them (a convex
 /// room: every surface sees every other, so visibility changes nothing).
 pub fn cornell_at_rest(blocks: bool) -> Scene {
