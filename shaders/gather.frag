@@ -49,8 +49,9 @@ layout(location = 1) out float out_evaluations; // light patches evaluated (a co
 vec3 e = vec3(0.0);
 uint evaluations = 0u;
 
-void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux) {
-    e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w);
+// level: patch_level of the patch (patch_irradiance).
+void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux, int level) {
+    e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
     evaluations += 1u;
 }
 
@@ -58,7 +59,8 @@ void patch_list(vec3 xi, vec3 ni) {
     for (uint j = 0u; j < patch_count; ++j) {
         LightPatch lp = patches[j];
         if (lp.position_area.w <= 0.0) continue;  // an empty regular VPL
-        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+        // A list's normal.w is the patch's patch_level (vpl_list.comp, isr_select.comp).
+        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, int(lp.normal.w));
     }
 }
 
@@ -114,7 +116,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
                 node = ivec3(2 * node.xy, node.z + 1);
                 continue;
             }
-            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, patch_level(run.rsm_top_level - node.z, lp.normal.w));
         }
         if (!next_node(node, root.z)) return;
     }
@@ -159,8 +161,10 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
         uint n = (c == c0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
         uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
         for (uint i = 0u; i < n; ++i) {
-            LightPatch lp = patches[cut[base + i]];  // a packed index
-            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb);
+            uint index = cut[base + i];  // a packed index
+            LightPatch lp = patches[index];
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
+                      patch_level(run.rsm_top_level - node_depth(index), lp.normal.w));
         }
     }
     uint capacity = cut_header.capacity[c0];

@@ -9,6 +9,10 @@
 // (light_tree_pack.comp): depth-major from the root, row-major inside.
 int node_index(ivec3 node) { return ((1 << (2 * node.z)) - 1) / 3 + node.y * (1 << node.z) + node.x; }
 
+// The depth of the node at packed index i: depth z holds indices
+// (4^z - 1) / 3 .. (4^(z+1) - 1) / 3 - 1, so 4^z <= 3 i + 1 < 4^(z+1).
+int node_depth(uint i) { return findMSB(3u * i + 1u) / 2; }
+
 // The node's squared reach: patch j splits for receiver i iff
 // |V_ij|^2 <= reach. Invalid patches have the reach over HISR_INVALID_TAU_SCALE.
 // Nodes at the max depth, and empty ones, never split: -1. light-tree-pack

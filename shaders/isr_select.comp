@@ -43,6 +43,7 @@ void main() {
     vec4 position = texelFetch(rsm_position, p, level);
     if (position.w <= 0.0) return;  // saw nothing
     uint slot = atomicAdd(count, 1u);
-    patches[slot] = LightPatch(position, vec4(texelFetch(rsm_normal, p, level).xyz, float(level)),
+    vec4 normal = texelFetch(rsm_normal, p, level);
+    patches[slot] = LightPatch(position, vec4(normal.xyz, float(patch_level(level, normal.w))),
                                texelFetch(rsm_flux, p, level));
 }

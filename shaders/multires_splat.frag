@@ -16,7 +16,7 @@ layout(set = 1, binding = 6) uniform sampler2D gbuffer_normal;
 
 layout(location = 0) flat in int level;
 layout(location = 1) flat in vec4 in_position;
-layout(location = 2) flat in vec3 in_normal;
+layout(location = 2) flat in vec4 in_normal;  // w: patch_level
 layout(location = 3) flat in vec3 in_flux;
 
 layout(location = 0) out vec4 out_irradiance;
@@ -26,6 +26,6 @@ void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec3 xi = geo_mean_at(p, level).xyz;
     vec3 ni = geo_normal_at(p, level).xyz;
-    out_irradiance = vec4(patch_irradiance(xi, ni, in_position.xyz, in_normal, in_flux, in_position.w), 1.0);
+    out_irradiance = vec4(patch_irradiance(xi, ni, in_position.xyz, in_normal.xyz, in_flux, in_position.w, int(in_normal.w)), 1.0);
     out_evaluations = 1.0;
 }

@@ -15,7 +15,7 @@ layout(set = 1, binding = 4) uniform sampler2D rsm_flux;
 
 layout(location = 0) flat out int out_level;
 layout(location = 1) flat out vec4 out_position;  // xyz: x_j; w: A_j
-layout(location = 2) flat out vec3 out_normal;
+layout(location = 2) flat out vec4 out_normal;  // w: patch_level
 layout(location = 3) flat out vec3 out_flux;
 
 void main() {
@@ -31,6 +31,6 @@ void main() {
     gl_Layer = level;
     out_level = level;
     out_position = pos;
-    out_normal = nrm.xyz;
+    out_normal = nrm;
     out_flux = flux;
 }

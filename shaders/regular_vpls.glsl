@@ -8,7 +8,8 @@
 
 int regular_vpl_count() { return run.vpl_side * run.vpl_side; }
 
-// VPL j in row-major order; false when its patch saw nothing lit.
+// VPL j in row-major order; false when its patch saw nothing lit. nrm.w:
+// its level as the lists keep it (patch_level in vpl.glsl).
 bool regular_vpl(int j, out vec4 pos, out vec4 nrm, out vec3 flux) {
     int k = run.vpl_level;
     int side = run.vpl_side;
@@ -26,6 +27,7 @@ bool regular_vpl(int j, out vec4 pos, out vec4 nrm, out vec3 flux) {
         nrm = texelFetch(rsm_normal, xy, k);
         flux = texelFetch(rsm_flux, xy, k).rgb;
     }
+    nrm.w = patch_level(k, nrm.w);
     return pos.w > 0.0;
 }
 

@@ -30,7 +30,7 @@ void main() {
         for (int j = first; j < min(last, regular_vpl_count()); ++j) {
             vec4 pos, nrm;
             vec3 flux;
-            if (regular_vpl(j, pos, nrm, flux)) e += patch_irradiance(p.xyz, n, pos.xyz, nrm.xyz, flux, pos.w);
+            if (regular_vpl(j, pos, nrm, flux)) e += patch_irradiance(p.xyz, n, pos.xyz, nrm.xyz, flux, pos.w, int(nrm.w));
         }
     }
     out_irradiance = vec4(e, 0.0);

@@ -1,8 +1,12 @@
 #version 460
 // One level of the RSM quadtree (docs/algorithm.md section 2, "A patch P"): each
 // texel of level k merges its four children of level k-1. Flux and solid angle
-// add up, area adds up, position is the area-weighted mean and the normal the
-// normalised area-weighted mean.
+// add up, area adds up, position is the flux-weighted mean (the area-weighted
+// one where the patch has no flux) and the normal the normalised
+// area-weighted mean. Flux-weighted: each texel's contribution is its flux
+// times a kernel of its position, so about that mean the first-order terms of
+// the kernel cancel however the flux varies over the patch (a cone's edge,
+// a texture), where about the area-weighted mean they do not.
 //
 // Validity (normal.w, see PATCH_*): a patch is valid when all its non-empty
 // children are valid and lie on one surface: each child's mean within the
@@ -31,6 +35,8 @@ void main() {
     vec4 flux = vec4(0.0);
     vec3 weighted_position = vec3(0.0);
     vec3 weighted_normal = vec3(0.0);
+    vec3 flux_position = vec3(0.0);  // positions weighted by the flux's luminance
+    float flux_weight = 0.0;
     float area = 0.0;
     bool children_valid = true;
     vec4 child_position[4];
@@ -39,13 +45,19 @@ void main() {
         ivec2 c = 2 * p + ivec2(i & 1, i >> 1);
         child_position[i] = imageLoad(src_position, c);
         child_normal[i] = imageLoad(src_normal, c);
-        flux += imageLoad(src_flux, c);
+        vec4 child_flux = imageLoad(src_flux, c);
+        flux += child_flux;
+        float luminance = dot(child_flux.rgb, vec3(0.2126, 0.7152, 0.0722));
+        flux_position += luminance * child_position[i].xyz;
+        flux_weight += luminance;
         weighted_position += child_position[i].w * child_position[i].xyz;
         weighted_normal += child_position[i].w * child_normal[i].xyz;
         area += child_position[i].w;
         children_valid = children_valid && child_normal[i].w != PATCH_INVALID;
     }
-    vec3 position = area > 0.0 ? weighted_position / area : vec3(0.0);
+    vec3 position = flux_weight > 0.0 ? flux_position / flux_weight
+                  : area > 0.0        ? weighted_position / area
+                                      : vec3(0.0);
     vec3 normal = dot(weighted_normal, weighted_normal) > 0.0 ? normalize(weighted_normal) : vec3(0.0);
     float state = PATCH_EMPTY;
     if (area > 0.0) {

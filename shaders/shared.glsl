@@ -86,12 +86,18 @@ struct RunUniforms {
     int visibility;               // VISIBILITY_*: the term the patch formula applies
     int visibility_side;          // N: finest cells per side of the grid (a power of 2)
     int visibility_levels;        // levels 0..visibility_levels-1, side N >> k (at least 4)
-    int pad_visibility;
+    int patch_kernel;             // PATCH_KERNEL_*: how a merged light patch is evaluated (vpl.glsl)
 };
 
 // RunUniforms::visibility: which visibility term patch_irradiance applies (vpl.glsl).
 const int VISIBILITY_NONE = 0;    // none: every patch lights every receiver it faces
 const int VISIBILITY_VOXELS = 1;  // the segment marched through the occupancy grid (visibility.glsl)
+
+// RunUniforms::patch_kernel (docs/algorithm.md section 2.6): a patch of
+// several RSM texels evaluated at its centre with the disc form factor, or
+// with the second-order term of its texels' spread added.
+const int PATCH_KERNEL_CENTRE = 0;
+const int PATCH_KERNEL_SECOND_ORDER = 1;
 
 // RunUniforms::hisr_tau_mode: what HISR's tau bounds (docs/algorithm.md 4.3).
 const int HISR_TAU_RELATIVE = 0;  // each evaluated patch's solid angle seen from the receiver
@@ -109,8 +115,8 @@ const float PI = 3.14159265358979323846;
 // One light patch chosen by Basic ISR (a node of the RSM quadtree).
 struct LightPatch {
     vec4 position_area;  // xyz: area-weighted mean position (m); w: area A (m^2)
-    vec4 normal;         // xyz: unit mean normal; w: RSM quadtree level (ISR's list) or
-                         // PATCH_* (HISR's packed tree)
+    vec4 normal;         // xyz: unit mean normal; w: patch_level (the lists: ISR's and
+                         // the regular VPLs') or PATCH_* (HISR's packed tree)
     vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr), or
                          // the squared reach (hisr_reach, HISR's packed tree)
 };
@@ -119,6 +125,12 @@ struct LightPatch {
 const float PATCH_EMPTY = 0.0;    // saw no geometry
 const float PATCH_VALID = 1.0;    // one surface: may stand for all its texels
 const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR never takes it whole)
+
+// A patch's level as patch_irradiance (vpl.glsl) and the light-patch lists take it: its
+// RSM quadtree level k (0: one texel), negated when it spans a discontinuity
+// (state PATCH_INVALID), whose texels lie on no one disc.
+int patch_level(int k, float state) { return state == PATCH_INVALID ? -k : k; }
+
 
 // HISR splits an invalid patch while its bound could exceed tau times this
 // (gather.frag, docs/algorithm.md section 4.3).

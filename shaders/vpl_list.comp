@@ -28,7 +28,7 @@ void main() {
     vec4 pos, nrm;
     vec3 flux;
     if (regular_vpl(j, pos, nrm, flux)) {
-        vpls[j] = LightPatch(pos, nrm, vec4(flux, 0.0));
+        vpls[j] = LightPatch(pos, nrm, vec4(flux, 0.0));  // nrm.w: patch_level
     } else {
         vpls[j] = LightPatch(vec4(0.0), vec4(0.0), vec4(0.0));
     }

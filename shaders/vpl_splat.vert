@@ -16,7 +16,7 @@ layout(set = 1, binding = 4) uniform sampler2D rsm_flux;
 #include "regular_vpls.glsl"
 
 layout(location = 0) flat out vec4 out_position;  // xyz: x_j; w: A_j
-layout(location = 1) flat out vec3 out_normal;
+layout(location = 1) flat out vec4 out_normal;  // w: patch_level
 layout(location = 2) flat out vec3 out_flux;
 
 // The NDC rectangle covering the sphere (centre c, radius r); the whole
@@ -48,6 +48,6 @@ void main() {
     // A degenerate quad (all vertices at one point) rasterizes nothing.
     gl_Position = live ? vec4(mix(rect.xy, rect.zw, q), 0.0, 1.0) : vec4(2.0, 2.0, 0.0, 1.0);
     out_position = pos;
-    out_normal = nrm.xyz;
+    out_normal = nrm;
     out_flux = flux;
 }

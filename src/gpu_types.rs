@@ -91,12 +91,18 @@ pub struct RunUniforms {
     pub visibility: i32,
     pub visibility_side: i32,
     pub visibility_levels: i32,
-    pub pad_visibility: i32,
+    /// How a merged light patch is evaluated (`passes::rsm_tree::PATCH_KERNEL`):
+    /// `PATCH_KERNEL_*`.
+    pub patch_kernel: i32,
 }
 
 /// `RunUniforms::visibility` values, as in `shaders/shared.glsl`.
 pub const VISIBILITY_NONE: i32 = 0;
 pub const VISIBILITY_VOXELS: i32 = 1;
+
+/// `RunUniforms::patch_kernel` values, as in `shaders/shared.glsl`.
+pub const PATCH_KERNEL_CENTRE: i32 = 0;
+pub const PATCH_KERNEL_SECOND_ORDER: i32 = 1;
 
 /// `VisibilityGridPush`: one dispatch of pass `visibility-grid`, a range of
 /// one instance's triangles.
@@ -141,7 +147,8 @@ impl InstanceTransform {
 pub struct LightPatch {
     /// xyz: mean position; w: area.
     pub position_area: [f32; 4],
-    /// xyz: mean normal; w: quadtree level (RSM mip).
+    /// xyz: mean normal; w: quadtree level (RSM mip), negated where the
+    /// patch spans a discontinuity (`patch_level` in `shaders/shared.glsl`).
     pub normal: [f32; 4],
     /// rgb: flux; a: solid angle (in HISR's packed tree: the squared reach).
     pub flux: [f32; 4],

@@ -124,7 +124,7 @@ fn frame_uniforms_match_shared_glsl() {
 #[test]
 fn run_uniforms_match_shared_glsl() {
     for shader in ["direct_light.frag", "gather.frag", "upsample.comp"] {
-        check!(shader, RunUniforms, "RunUniforms", pad_visibility: 4, [
+        check!(shader, RunUniforms, "RunUniforms", patch_kernel: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
             pcf_radius => "pcf_radius",
@@ -151,7 +151,7 @@ fn run_uniforms_match_shared_glsl() {
             visibility => "visibility",
             visibility_side => "visibility_side",
             visibility_levels => "visibility_levels",
-            pad_visibility => "pad_visibility",
+            patch_kernel => "patch_kernel",
         ]);
     }
 }
@@ -271,6 +271,11 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
     assert_eq!(value("VISIBILITY_NONE"), VISIBILITY_NONE as u32);
     assert_eq!(value("VISIBILITY_VOXELS"), VISIBILITY_VOXELS as u32);
+    assert_eq!(value("PATCH_KERNEL_CENTRE"), PATCH_KERNEL_CENTRE as u32);
+    assert_eq!(
+        value("PATCH_KERNEL_SECOND_ORDER"),
+        PATCH_KERNEL_SECOND_ORDER as u32
+    );
     assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     let float = |name: &str| -> f32 {
         let line = glsl

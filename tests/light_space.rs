@@ -127,11 +127,17 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
     let regular = render_multires(
         &gpu,
         &scene,
-        &settings(Method::new("multires-gather"), 128).with(&VPLS, base * base),
+        // The same tree: its validity says how each patch is evaluated
+        // (patch_level: a patch spanning a discontinuity at its centre).
+        &settings(Method::new("multires-gather"), 128)
+            .with(&VPLS, base * base)
+            .with(&VALIDITY_DEPTH, 0.0)
+            .with(&VALIDITY_NORMAL, 0.0),
     );
     let base_mip = (128u32 / base).ilog2() as f32;
     assert!(
-        chosen.iter().all(|p| p.normal[3] == base_mip),
+        // normal.w: the level, negated where the patch spans a discontinuity.
+        chosen.iter().all(|p| p.normal[3].abs() == base_mip),
         "every chosen patch is a base patch"
     );
     let non_empty = regular.multires.rsm_tree[base_mip as usize][0]

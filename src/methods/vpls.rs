@@ -56,7 +56,8 @@ pub const VPL_SAMPLING: Param<VplSampling> = Param {
     range: Range::ANY,
 };
 
-pub const PARAMS: &[&dyn AnyParam] = &[&VPLS, &VPL_SAMPLING];
+pub const PARAMS: &[&dyn AnyParam] =
+    &[&VPLS, &VPL_SAMPLING, &crate::passes::rsm_tree::PATCH_KERNEL];
 
 /// The regular VPLs of a run: how many, how many per side, and the RSM
 /// quadtree level they are. The host's draw counts and dispatch sizes and

@@ -9,8 +9,8 @@
 
 use super::{ComputePass, INDIRECT_COMPUTE};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::RunUniforms;
-use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
+use crate::gpu_types::{self, RunUniforms};
+use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::RenderSettings;
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::Binding;
@@ -37,12 +37,57 @@ pub const VALIDITY_NORMAL: Param<f32> = Param {
     range: Range::closed(0.0, 180.0),
 };
 
-pub const PARAMS: &[&dyn AnyParam] = &[&VALIDITY_DEPTH, &VALIDITY_NORMAL];
+/// How a light patch of several RSM texels is evaluated (docs/algorithm.md
+/// section 2.6, `patch_irradiance` in `shaders/vpl.glsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatchKernel {
+    /// At its centre, with the disc form factor: the talk's.
+    Centre,
+    /// With the second-order term of its texels' spread about the centre.
+    SecondOrder,
+}
 
-/// The validity thresholds in the run uniforms (every run builds the tree).
+impl Choices for PatchKernel {
+    const NAMES: &'static [(&'static str, &'static str)] = &[
+        (
+            "centre",
+            "a merged light patch lights a receiver as one disc-shaped VPL at its centre (the \
+             talk's)",
+        ),
+        (
+            "second-order",
+            "the same, with the second-order term of its texels' spread over the disc added: \
+             whole patches err far less at the same cost",
+        ),
+    ];
+    fn index(self) -> usize {
+        self as usize
+    }
+    fn from_index(i: usize) -> Self {
+        [PatchKernel::Centre, PatchKernel::SecondOrder][i]
+    }
+}
+
+pub const PATCH_KERNEL: Param<PatchKernel> = Param {
+    name: "patch-kernel",
+    help: "How a light patch of several RSM texels lights a receiver: at its centre (centre, \
+           the talk's) or with the second-order term of its texels' spread (second-order); \
+           single texels are the same in both",
+    default: DefaultValue::Fixed(PatchKernel::SecondOrder),
+    range: Range::ANY,
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&VALIDITY_DEPTH, &VALIDITY_NORMAL, &PATCH_KERNEL];
+
+/// The validity thresholds and the patch kernel in the run uniforms (every
+/// run builds the tree).
 pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
     u.validity_depth = VALIDITY_DEPTH.get(s);
     u.validity_normal_cos = VALIDITY_NORMAL.get(s).to_radians().cos();
+    u.patch_kernel = match PATCH_KERNEL.get(s) {
+        PatchKernel::Centre => gpu_types::PATCH_KERNEL_CENTRE,
+        PatchKernel::SecondOrder => gpu_types::PATCH_KERNEL_SECOND_ORDER,
+    };
 }
 
 pub struct RsmTreePass(ComputePass);
