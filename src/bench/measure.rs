@@ -1,33 +1,39 @@
-//! Measuring one scene of a bench run: its dense reference and path-traced
-//! truth per frame, then every pending sweep point against them, each
-//! finished point's row appended to the journal.
+//! Measuring one scene of a bench run, pass by pass (one per visibility,
+//! `Plan::passes`): the pass's dense reference per frame, then every pending
+//! sweep point of the pass against it and against the path-traced truth,
+//! traced once per frame for every pass; each finished row is appended to
+//! the journal.
 
 use super::rows::{self, Row};
 use super::sweep::Config;
 use super::{charts, flip, frame_time, metrics, truth_cache, Plan, SceneSpec};
-use super::{REFERENCE, REFERENCE_LABEL};
+use super::{visibility, REFERENCE, REFERENCE_LABEL};
+use crate::passes::visibility_grid::Visibility;
 use crate::readback::Readback;
 use crate::renderer::{FrameStats, Renderer};
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::Gpu;
 use anyhow::{Context as _, Result};
+use std::collections::HashSet;
 use std::path::Path;
 
-/// One frame of the dense reference, what every method is compared with,
-/// and of the path-traced truth where points are measured.
+/// One frame of a pass's dense reference, what its points are compared with.
 struct RefFrame {
     indirect: Vec<[f32; 4]>,
     final_radiance: Vec<[f32; 4]>,
     mask: Vec<bool>,
     display: Vec<u8>,
-    truth: Option<TruthFrame>,
 }
 
-/// The path-traced truth's indirect image and the pixels it is compared on.
+/// One frame of the path-traced truth: its indirect image, the pixels it is
+/// compared on, and what the reference rows report of it.
 struct TruthFrame {
     indirect: Vec<[f32; 4]>,
     mask: Vec<bool>,
+    spp: f64,
+    noise: f64,
+    left_out: f64,
 }
 
 /// The total the GPU allocator has handed out, in bytes.
@@ -36,106 +42,205 @@ fn allocated_bytes(gpu: &Gpu) -> Option<i64> {
     Some(a.generate_report().total_allocated_bytes as i64)
 }
 
-/// What a scene of the run still needs.
+/// What a pass of a scene still needs.
 pub(super) struct Pending {
     /// Points to measure (not in the journal).
-    pub todo: Vec<Config>,
+    todo: Vec<Config>,
     /// Default points in the journal whose gallery images are missing.
-    pub redraw: Vec<Config>,
+    redraw: Vec<Config>,
     /// Whether the reference's row is to be written.
-    pub ref_row: bool,
+    ref_row: bool,
     /// Animation frames of the reference to render.
-    pub ref_frames: u32,
+    ref_frames: u32,
 }
 
+impl Pending {
+    /// What pass `plan` of `spec` needs that the journal (its keys, `done`)
+    /// and the gallery's images lack; `None`: nothing.
+    pub(super) fn of(plan: &Plan, spec: &SceneSpec, done: &HashSet<String>) -> Option<Pending> {
+        let configs = plan.configs();
+        let name = &spec.name;
+        let is_done =
+            |c: &Config| done.contains(&plan.key(name, c.method.name(), &c.label(&plan.base)));
+        let todo: Vec<Config> = configs.iter().filter(|c| !is_done(c)).cloned().collect();
+        let redraw: Vec<Config> = configs
+            .iter()
+            .filter(|c| is_done(c) && c.is_default(&plan.base))
+            .filter(|c| !super::images_present(plan, spec, Some(c)))
+            .cloned()
+            .collect();
+        let ref_row = !done.contains(&plan.key(name, REFERENCE.name(), REFERENCE_LABEL));
+        let measures = ref_row || !todo.is_empty();
+        if !measures && redraw.is_empty() && super::images_present(plan, spec, None) {
+            return None;
+        }
+        // The reference's every frame where a point is measured; up to the
+        // gallery's frame where only images are drawn again.
+        let ref_frames = match measures {
+            true => plan.frames,
+            false => image_frames(plan),
+        };
+        Some(Pending {
+            todo,
+            redraw,
+            ref_row,
+            ref_frames,
+        })
+    }
+
+    /// Whether it writes a row (and so needs the truth, where there is one).
+    pub(super) fn measures(&self) -> bool {
+        self.ref_row || !self.todo.is_empty()
+    }
+
+    /// Frames it renders (the progress bar's units), the truth's apart.
+    pub(super) fn frames(&self, plan: &Plan) -> u64 {
+        self.ref_frames as u64
+            + plan.frames as u64 * self.todo.len() as u64
+            + image_frames(plan) as u64 * self.redraw.len() as u64
+    }
+}
+
+/// Frames up to the gallery's, the middle one.
+fn image_frames(plan: &Plan) -> u32 {
+    plan.frames / 2 + 1
+}
+
+/// Renders what `passes` of scene `spec` (`Plan::passes` with what each
+/// needs) still need. Each frame's truth is traced, or read from its cache,
+/// once, by the first pass that measures, and serves every pass after it.
 pub(super) fn run_scene(
+    gpu: &Gpu,
+    spec: &SceneSpec,
+    scene: &Scene,
+    passes: &[(Plan, Pending)],
+    journal: &Path,
+    bar: &indicatif::ProgressBar,
+) -> Result<()> {
+    let frames = passes.iter().map(|(p, _)| p.frames).max().unwrap_or(0);
+    let mut truths: Vec<Option<TruthFrame>> = (0..frames).map(|_| None).collect();
+    for (plan, work) in passes {
+        let refs = reference(plan, gpu, spec, scene, work, &mut truths, journal, bar)?;
+        points(plan, gpu, spec, scene, work, &refs, &truths, journal, bar)?;
+    }
+    Ok(())
+}
+
+/// The dense reference of pass `plan`, every frame it needs, with the truth
+/// of each frame (traced where `truths` lacks it); its row where the
+/// journal lacks it.
+#[allow(clippy::too_many_arguments)]
+fn reference(
     plan: &Plan,
     gpu: &Gpu,
     spec: &SceneSpec,
     scene: &Scene,
     work: &Pending,
+    truths: &mut [Option<TruthFrame>],
     journal: &Path,
     bar: &indicatif::ProgressBar,
-) -> Result<()> {
+) -> Result<Vec<RefFrame>> {
     let ref_row = work.ref_row;
     let images = plan.out_dir.join("images").join(&spec.name);
-    let with_truth = plan.truth_noise.is_some() && (ref_row || !work.todo.is_empty());
-    // The dense reference of every frame, once, and its path-traced truth.
+    let with_truth = plan.truth_noise.is_some() && work.measures();
+    let name = visibility::series_name("reference", &plan.visibility_label());
     let mut refs = Vec::with_capacity(plan.frames as usize);
     let mut ref_stats = FrameStats::default();
     let mut model = rows::TruthErrors::default();
-    {
-        let settings = settings_of(plan, REFERENCE);
-        let mut r = Renderer::new(gpu, scene, &settings)?;
-        for k in 0..work.ref_frames {
-            bar.set_message(format!(
-                "{}: reference, frame {}/{}",
-                spec.name,
-                k + 1,
-                work.ref_frames
-            ));
-            let state = scene.pose_at(frame_time(spec, k))?;
-            r.update(&state)?;
-            let last = k + 1 == plan.frames;
-            ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
-            let out = r.readback()?;
-            let truth = if with_truth {
-                let posed = state.pose(scene);
-                let t = truth_cache::frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
-                // Only the reference's row keeps the floor: minutes of rays
-                // when not cached, so not traced for a row already measured.
-                if ref_row && k == plan.frames / 2 {
-                    let exact = truth_cache::model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
-                    model.floor = Some(metrics::relative_rmse(
-                        &exact,
-                        &t.image.indirect,
-                        &t.mask.mask,
-                    ));
+    let settings = settings_of(plan, REFERENCE);
+    let mut r = Renderer::new(gpu, scene, &settings)?;
+    for k in 0..work.ref_frames {
+        bar.set_message(format!(
+            "{}: {name}, frame {}/{}",
+            spec.name,
+            k + 1,
+            work.ref_frames
+        ));
+        let state = scene.pose_at(frame_time(spec, k))?;
+        r.update(&state)?;
+        let last = k + 1 == plan.frames;
+        ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
+        let out = r.readback()?;
+        if with_truth {
+            let posed = state.pose(scene);
+            let slot = &mut truths[k as usize];
+            let t = match slot.take() {
+                Some(t) => slot.insert(t),
+                None => {
+                    let t = truth_cache::frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
+                    bar.inc(1);
+                    slot.insert(TruthFrame {
+                        spp: t.spp as f64,
+                        noise: t.noise,
+                        left_out: t.mask.left_out(),
+                        indirect: t.image.indirect,
+                        mask: t.mask.mask,
+                    })
                 }
-                let n = plan.frames as f64;
-                let e = metrics::relative_rmse(&out.indirect, &t.image.indirect, &t.mask.mask);
-                let add = |v: &mut Option<f64>, x: f64| *v = Some(v.unwrap_or(0.0) + x / n);
-                add(&mut model.rel_rmse_indirect, e);
-                add(&mut model.spp, t.spp as f64);
-                add(&mut model.noise, t.noise);
-                add(&mut model.left_out, t.mask.left_out());
-                bar.inc(1);
-                Some(TruthFrame {
-                    indirect: t.image.indirect,
-                    mask: t.mask.mask,
-                })
-            } else {
-                None
             };
-            if k == plan.frames / 2 {
-                crate::output::write_png(
-                    &images.join("reference.png"),
-                    out.width,
-                    out.height,
-                    &out.display,
-                )?;
+            // Only the reference's row without visibility keeps the floor:
+            // minutes of rays when not cached, so not traced for a row
+            // already measured.
+            if ref_row && k == plan.frames / 2 && plan.visibility() == Visibility::None {
+                let exact = truth_cache::model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
+                model.floor = Some(metrics::relative_rmse(&exact, &t.indirect, &t.mask));
             }
-            refs.push(RefFrame {
-                mask: metrics::geometry_mask(&out.position),
-                indirect: out.indirect,
-                final_radiance: out.final_radiance,
-                display: out.display,
-                truth,
-            });
-            bar.inc(1);
+            let n = plan.frames as f64;
+            let e = metrics::relative_rmse(&out.indirect, &t.indirect, &t.mask);
+            let add = |v: &mut Option<f64>, x: f64| *v = Some(v.unwrap_or(0.0) + x / n);
+            add(&mut model.rel_rmse_indirect, e);
+            add(&mut model.spp, t.spp);
+            add(&mut model.noise, t.noise);
+            add(&mut model.left_out, t.left_out);
         }
+        if k == plan.frames / 2 {
+            crate::output::write_png(
+                &images.join(super::reference_image(plan)),
+                out.width,
+                out.height,
+                &out.display,
+            )?;
+        }
+        refs.push(RefFrame {
+            mask: metrics::geometry_mask(&out.position),
+            indirect: out.indirect,
+            final_radiance: out.final_radiance,
+            display: out.display,
+        });
+        bar.inc(1);
     }
     if ref_row {
-        let mut row = timing_row(plan, spec, &settings_of(plan, REFERENCE), &ref_stats);
+        let mut row = timing_row(plan, spec, &settings, &ref_stats);
         row.label = REFERENCE_LABEL.into();
-        row.key = plan.key(&spec.name, "reference", REFERENCE_LABEL);
+        row.key = plan.key(&spec.name, REFERENCE.name(), REFERENCE_LABEL);
         row.is_default = true;
         row.truth = model;
         rows::append(journal, &row)?;
     }
-    // The allocator's total without any indirect method, to subtract.
+    Ok(refs)
+}
+
+/// Every point of pass `plan` still to measure or draw, against the pass's
+/// reference `refs` and the truth `truths` of each frame.
+#[allow(clippy::too_many_arguments)]
+fn points(
+    plan: &Plan,
+    gpu: &Gpu,
+    spec: &SceneSpec,
+    scene: &Scene,
+    work: &Pending,
+    refs: &[RefFrame],
+    truths: &[Option<TruthFrame>],
+    journal: &Path,
+    bar: &indicatif::ProgressBar,
+) -> Result<()> {
+    let images = plan.out_dir.join("images").join(&spec.name);
+    let shown = plan.visibility_label();
+    // The allocator's total without any indirect method, to subtract; and
+    // without the grid, which is part of what visibility costs a method.
     let baseline = {
-        let _none = Renderer::new(gpu, scene, &settings_of(plan, crate::methods::none::KEY))?;
+        let none = settings_of(plan, crate::methods::none::KEY);
+        let _none = Renderer::new(gpu, scene, &visibility::with(&none, Visibility::None))?;
         allocated_bytes(gpu)
     };
     let points = work.todo.iter().map(|c| (c, true));
@@ -144,12 +249,13 @@ pub(super) fn run_scene(
         let frames = if measure {
             plan.frames
         } else {
-            plan.frames / 2 + 1
+            image_frames(plan)
         };
         let settings = c.settings(&plan.base);
         let label = c.label(&plan.base);
+        let name = visibility::series_name(c.method.name(), &shown);
         let mut r = Renderer::new(gpu, scene, &settings)
-            .with_context(|| format!("{} {label} on {}", c.method.name(), spec.name))?;
+            .with_context(|| format!("{name} {label} on {}", spec.name))?;
         let memory = match (allocated_bytes(gpu), baseline) {
             (Some(a), Some(b)) => Some(a - b),
             _ => None,
@@ -162,9 +268,8 @@ pub(super) fn run_scene(
         let mut evals = None;
         for k in 0..frames {
             bar.set_message(format!(
-                "{}: {} {label}, frame {}/{frames}{}",
+                "{}: {name} {label}, frame {}/{frames}{}",
                 spec.name,
-                c.method.name(),
                 k + 1,
                 if measure { "" } else { " (images only)" }
             ));
@@ -180,7 +285,7 @@ pub(super) fn run_scene(
             let out = r.readback()?;
             let reference = &refs[k as usize];
             e_ind += metrics::relative_rmse(&out.indirect, &reference.indirect, &reference.mask);
-            if let Some(t) = &reference.truth {
+            if let Some(t) = &truths[k as usize] {
                 let e = metrics::relative_rmse(&out.indirect, &t.indirect, &t.mask);
                 e_truth = Some(e_truth.unwrap_or(0.0) + e);
             }
@@ -207,15 +312,10 @@ pub(super) fn run_scene(
                 evals = light_patch_evals(&r, &settings, &out)?;
             }
             if k == plan.frames / 2 && c.is_default(&plan.base) {
-                let name = c.method.name();
+                let [image, error] = super::point_images(plan, c);
+                crate::output::write_png(&images.join(image), out.width, out.height, &out.display)?;
                 crate::output::write_png(
-                    &images.join(format!("{name}.png")),
-                    out.width,
-                    out.height,
-                    &out.display,
-                )?;
-                crate::output::write_png(
-                    &images.join(format!("{name}-error.png")),
+                    &images.join(error),
                     out.width,
                     out.height,
                     &charts::heat_map(&map),
@@ -244,9 +344,8 @@ pub(super) fn run_scene(
         if bar.is_hidden() {
             // No terminal (a log, CI): one line per finished row instead.
             eprintln!(
-                "{}: {} {}: {:.1} ms indirect, relative RMSE {:.4}",
+                "{}: {name} {}: {:.1} ms indirect, relative RMSE {:.4}",
                 row.scene,
-                row.method,
                 row.label,
                 row.indirect_ms.unwrap_or(f64::NAN),
                 row.rel_rmse_indirect
@@ -316,6 +415,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         key: String::new(),
         scene: spec.name.clone(),
         method: s.method.name().into(),
+        visibility: visibility::label(s),
         label: String::new(),
         is_default: false,
         params: parameter_values(s),

@@ -14,7 +14,9 @@ pub mod scenes;
 pub mod sweep;
 pub mod truth;
 mod truth_cache;
+pub mod visibility;
 
+use crate::passes::visibility_grid::Visibility;
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::{Gpu, GpuOptions};
@@ -63,13 +65,22 @@ pub struct BenchArgs {
     /// stress scenes; quick 0.1). 0 traces no truth.
     #[arg(long)]
     pub truth_noise: Option<f64>,
+    /// Indirect visibility (comma-separated): every method renders with
+    /// `none`, and every method that reads visibility (the gathers, the
+    /// splats, the dense reference; not lpv) again with each further entry,
+    /// against a dense reference with the same visibility. `voxels`: the
+    /// grid of --visibility-grid. Default: none,voxels (quick: none).
+    /// `exact` is refused (CPU minutes a frame; `isr render --method
+    /// reference --visibility exact`).
+    #[arg(long, value_delimiter = ',', num_args = 1.., value_name = "none|voxels")]
+    pub visibility: Vec<String>,
     /// Vulkan device index (`isr devices`).
     #[arg(long)]
     pub device: Option<usize>,
     /// Parameters every point renders with, where its sweep does not set
     /// them (`--levels 4`: every multiresolution method at 4 levels).
     #[command(flatten)]
-    pub params: crate::methods::ParamArgs,
+    pub params: crate::methods::ParamArgsButVisibility,
 }
 
 impl Default for BenchArgs {
@@ -85,6 +96,7 @@ impl Default for BenchArgs {
             out_dir: "out/bench".into(),
             quick: false,
             truth_noise: None,
+            visibility: vec![],
             device: None,
             params: Default::default(),
         }
@@ -104,6 +116,9 @@ pub struct Plan {
     pub device: Option<usize>,
     /// The truth's noise target; `None`: no truth.
     pub truth_noise: Option<f64>,
+    /// The visibility axis (`--visibility`; `visibility::parse`); a pass's
+    /// plan (`Plan::passes`): its one visibility.
+    pub visibilities: Vec<Visibility>,
 }
 
 /// A scene of the run: its name, how it is made, its animation window, and
@@ -234,22 +249,32 @@ impl BenchArgs {
                 "--truth-noise {truth_noise}: the path-traced truth's noise target must be at least 0 (no truth) and under 1; 0.02 is the default"
             );
         }
+        let visibilities = visibility::parse(&self.visibility, q)?;
+        let base = RenderSettings {
+            width,
+            height,
+            rsm_resolution: rsm,
+            params: self.params.0.clone(),
+            ..RenderSettings::DEFAULT
+        };
+        // Each pass sets its own (`Plan::passes`); a grid out of range is
+        // refused before any work.
+        let base = visibility::with(&base, Visibility::None);
+        if visibilities.contains(&Visibility::Voxels) {
+            use crate::settings::params::AnyParam as _;
+            crate::passes::visibility_grid::GRID.check(&base)?;
+        }
         Ok(Plan {
             scenes: specs,
             methods,
-            base: RenderSettings {
-                width,
-                height,
-                rsm_resolution: rsm,
-                params: self.params.0.clone(),
-                ..RenderSettings::DEFAULT
-            },
+            base,
             frames,
             timing_frames,
             quick: q,
             out_dir: self.out_dir.clone(),
             device: self.device,
             truth_noise: (truth_noise > 0.0).then_some(truth_noise),
+            visibilities,
         })
     }
 }
@@ -299,14 +324,18 @@ impl Plan {
         )
     }
 
-    /// Every key this run produces, in report order.
-    pub fn keys(&self) -> Vec<String> {
+    /// Every key this run produces with its rows' visibility, in report
+    /// order: per scene, each pass's reference and points.
+    pub fn keys(&self) -> Vec<(String, String)> {
         let mut keys = vec![];
         for s in &self.scenes {
-            let p = self.for_scene(s);
-            keys.push(p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL));
-            for c in p.configs() {
-                keys.push(p.key(&s.name, c.method.name(), &c.label(&p.base)));
+            for p in self.for_scene(s).passes() {
+                let v = p.visibility_label();
+                keys.push((p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL), v.clone()));
+                for c in p.configs() {
+                    let k = p.key(&s.name, c.method.name(), &c.label(&p.base));
+                    keys.push((k, v.clone()));
+                }
             }
         }
         keys
@@ -323,18 +352,30 @@ pub struct Outcome {
     pub driver: String,
 }
 
-/// The images of `spec` that the gallery shows, written by [`measure::run_scene`] at
-/// the middle animation frame: the reference's and, per method with a
-/// default point, that point's image and FLIP map.
+/// The images of `spec` that the gallery shows, written by
+/// [`measure::run_scene`] at the middle animation frame for pass `plan`
+/// (`Plan::passes`): the reference's and, per method with a default point,
+/// that point's image and FLIP map.
 fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
     let images = plan.out_dir.join("images").join(&spec.name);
-    let mut files = vec![images.join("reference.png")];
+    let mut files = vec![images.join(reference_image(plan))];
     for c in plan.configs().iter().filter(|c| c.is_default(&plan.base)) {
-        let m = c.method.name();
-        files.push(images.join(format!("{m}.png")));
-        files.push(images.join(format!("{m}-error.png")));
+        files.extend(point_images(plan, c).map(|n| images.join(n)));
     }
     files
+}
+
+/// The gallery image of pass `plan`'s reference: `reference.png`, or with
+/// the grid `reference-voxels.png`.
+fn reference_image(plan: &Plan) -> String {
+    format!("reference{}.png", plan.image_suffix())
+}
+
+/// The gallery images of point `c` of pass `plan`, its image and its FLIP
+/// map: `hisr.png` and `hisr-error.png`, or `hisr-voxels.png` ...
+fn point_images(plan: &Plan, c: &Config) -> [String; 2] {
+    let (m, v) = (c.method.name(), plan.image_suffix());
+    [format!("{m}{v}.png"), format!("{m}{v}-error.png")]
 }
 
 /// Whether the gallery images of point `c` of `spec` (or, without one, the
@@ -342,11 +383,8 @@ fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
 fn images_present(plan: &Plan, spec: &SceneSpec, c: Option<&Config>) -> bool {
     let images = plan.out_dir.join("images").join(&spec.name);
     let names = match c {
-        None => vec!["reference.png".to_string()],
-        Some(c) => {
-            let m = c.method.name();
-            vec![format!("{m}.png"), format!("{m}-error.png")]
-        }
+        None => vec![reference_image(plan)],
+        Some(c) => point_images(plan, c).to_vec(),
     };
     names.iter().all(|n| images.join(n).is_file())
 }
@@ -368,7 +406,9 @@ fn check_outputs(plan: &Plan) -> Result<()> {
         .map(|n| dir.join(n))
         .collect();
     for s in &plan.scenes {
-        files.extend(gallery_images(&plan.for_scene(s), s));
+        for p in plan.for_scene(s).passes() {
+            files.extend(gallery_images(&p, s));
+        }
     }
     for f in files {
         crate::output::check_output("bench output", &f, Some(&remedy))?;
@@ -394,73 +434,41 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
         ..Default::default()
     })?;
     crate::bench::charts::register_font();
-    // Work units: one per frame rendered (reference and every pending point).
-    let mut pending: Vec<(SceneSpec, Pending)> = vec![];
+    // Work units: one per frame rendered (each pass's reference and every
+    // pending point) and per frame traced (the truth, once per scene).
+    let mut pending: Vec<(SceneSpec, Vec<(Plan, Pending)>)> = vec![];
     let mut units = 0u64;
-    let run_plan = plan;
-    for s in &run_plan.scenes {
-        let plan = &run_plan.for_scene(s);
-        let configs = plan.configs();
-        let image_frames = plan.frames / 2 + 1;
-        let is_done =
-            |c: &Config| done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base)));
-        let todo: Vec<Config> = configs.iter().filter(|c| !is_done(c)).cloned().collect();
-        let redraw: Vec<Config> = configs
-            .iter()
-            .filter(|c| is_done(c) && c.is_default(&plan.base))
-            .filter(|c| !images_present(plan, s, Some(c)))
-            .cloned()
+    for s in &plan.scenes {
+        let scene_plan = plan.for_scene(s);
+        let passes: Vec<(Plan, Pending)> = scene_plan
+            .passes()
+            .into_iter()
+            .filter_map(|p| Pending::of(&p, s, &done).map(|w| (p, w)))
             .collect();
-        let ref_row = !done.contains(&plan.key(&s.name, "reference", REFERENCE_LABEL));
-        if todo.is_empty() && !ref_row && redraw.is_empty() && images_present(plan, s, None) {
+        if passes.is_empty() {
             continue;
         }
-        // The reference's every frame where a point is measured; up to the
-        // gallery's frame where only images are drawn again.
-        let ref_frames = if todo.is_empty() && !ref_row {
-            image_frames
-        } else {
-            plan.frames
-        };
-        // The truth is traced with the reference where anything is measured.
-        let truth_frames = if plan.truth_noise.is_none() || (todo.is_empty() && !ref_row) {
-            0
-        } else {
-            plan.frames
-        };
-        units += ref_frames as u64
-            + truth_frames as u64
-            + plan.frames as u64 * todo.len() as u64
-            + image_frames as u64 * redraw.len() as u64;
-        pending.push((
-            s.clone(),
-            Pending {
-                todo,
-                redraw,
-                ref_row,
-                ref_frames,
-            },
-        ));
+        if scene_plan.truth_noise.is_some() && passes.iter().any(|(_, w)| w.measures()) {
+            units += scene_plan.frames as u64;
+        }
+        units += passes.iter().map(|(p, w)| w.frames(p)).sum::<u64>();
+        pending.push((s.clone(), passes));
     }
     let bar = crate::progress::bar(units, "frames");
-    for (spec, work) in &pending {
+    for (spec, passes) in &pending {
         let scene = spec.load(&gpu)?;
-        run_scene(
-            &plan.for_scene(spec),
-            &gpu,
-            spec,
-            &scene,
-            work,
-            &journal,
-            &bar,
-        )?;
+        run_scene(&gpu, spec, &scene, passes, &journal, &bar)?;
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;
+    // Rows journalled before the axis have no visibility: their key's.
     let rows: Vec<Row> = plan
         .keys()
-        .iter()
-        .filter_map(|k| all.iter().rev().find(|r| &r.key == k).cloned())
+        .into_iter()
+        .filter_map(|(k, visibility)| {
+            let r = all.iter().rev().find(|r| r.key == k).cloned()?;
+            Some(Row { visibility, ..r })
+        })
         .collect();
     let outcome = Outcome {
         rows,
