@@ -233,6 +233,10 @@ fn flicker_tells_64_vpls_from_4096_where_light_is_near_contact() {
             "1",
             "--truth-noise",
             "0",
+            // The measure is the talk's model's: the grid's pass would
+            // multiply the run's minutes.
+            "--visibility",
+            "none",
             "--out-dir",
             d,
         ])
@@ -290,5 +294,111 @@ fn bad_names_list_the_valid_ones() {
         err.contains("--truth-noise 1.5") && err.contains("0.02"),
         "{err}"
     );
+    // Exact visibility is CPU minutes a frame: not a bench visibility.
+    let err = fails(&["--visibility", "none,exact"]);
+    assert!(
+        err.contains("--visibility exact") && err.contains("isr render --method reference"),
+        "{err}"
+    );
+    let err = fails(&["--visibility", "rays"]);
+    assert!(
+        err.contains("'rays'") && err.contains("none, voxels"),
+        "{err}"
+    );
+    let err = fails(&["--visibility", "voxels", "--visibility-grid", "48"]);
+    assert!(err.contains("--visibility-grid 48"), "{err}");
     assert!(!dir.join("rows.jsonl").exists());
+}
+
+/// The visibility axis (issue 25 part 3), at 32x32 on the box with its
+/// blocks: `--visibility none,voxels` renders HISR, which reads indirect
+/// visibility, without and with the grid, each point against the dense
+/// reference of its visibility; LPV, which reads none, once. The grid
+/// occludes the light the blocks hide: the dense reference comes nearer the
+/// truth (measured 0.137 to 0.101), and every HISR point moves.
+#[test]
+fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
+    let dir = temp_dir("bench-visibility");
+    let d = dir.to_str().unwrap();
+    let run = |visibility: &str| {
+        Isr::new("bench")
+            .args(["--scenes", "cornell", "--methods", "hisr,lpv", "--quick"])
+            .args(["--width", "32", "--height", "32", "--rsm", "32"])
+            .args(["--frames", "2", "--timing-frames", "1"])
+            .args(["--visibility", visibility, "--out-dir", d])
+            .succeeds();
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap())
+                .unwrap();
+        json["rows"].as_array().unwrap().clone()
+    };
+    let rows = run("none,voxels");
+    let of = |method: &str, visibility: &str| -> Vec<&serde_json::Value> {
+        rows.iter()
+            .filter(|r| r["method"] == method && r["visibility"] == visibility)
+            .collect()
+    };
+    let hisr = isr::bench::sweep::sweep(isr::methods::hisr::KEY, 32, true).len();
+    let lpv = isr::bench::sweep::sweep(isr::methods::lpv::KEY, 32, true).len();
+    assert_eq!(of("hisr", "none").len(), hisr);
+    assert_eq!(of("hisr", "voxels 64").len(), hisr);
+    assert_eq!(of("lpv", "none").len(), lpv);
+    assert!(of("lpv", "voxels 64").is_empty());
+    assert_eq!(rows.len(), 2 + 2 * hisr + lpv);
+    // Rows without visibility keep the keys of runs before the axis.
+    for r in &rows {
+        let key = r["key"].as_str().unwrap();
+        assert_eq!(
+            key.ends_with("|voxels 64"),
+            r["visibility"] == "voxels 64",
+            "{key}"
+        );
+    }
+    let truth = |r: &serde_json::Value| r["truth"]["rel_rmse_indirect"].as_f64().unwrap();
+    let (without, with) = (of("reference", "none"), of("reference", "voxels 64"));
+    println!(
+        "reference against the truth: {:.4} without, {:.4} with the grid",
+        truth(without[0]),
+        truth(with[0])
+    );
+    assert!(
+        truth(with[0]) < 0.9 * truth(without[0]),
+        "the dense reference against the truth: {} without the grid, {} with",
+        truth(without[0]),
+        truth(with[0])
+    );
+    for (a, b) in of("hisr", "none").into_iter().zip(of("hisr", "voxels 64")) {
+        assert_eq!(a["label"], b["label"]);
+        let (ta, tb) = (truth(a), truth(b));
+        println!(
+            "hisr {}: {ta:.4} without, {tb:.4} with the grid",
+            a["label"]
+        );
+        assert!(
+            (ta - tb).abs() > 0.01 * ta,
+            "hisr {}: {ta} and {tb}",
+            a["label"]
+        );
+        // Each against its own dense reference: near it, not near the other.
+        assert!(b["rel_rmse_indirect"].as_f64().unwrap() < 0.1, "{b}");
+    }
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    assert!(csv.starts_with("scene,method,visibility,label,"), "{csv}");
+    assert!(csv.contains("\ncornell,hisr,voxels 64,"), "{csv}");
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(report.contains("## Indirect visibility: none against voxels 64"));
+    assert!(report.contains("| cornell | hisr | tau "), "{report}");
+    let images = dir.join("images/cornell");
+    assert!(
+        images.join("hisr-voxels.png").is_file() && images.join("reference-voxels.png").is_file()
+    );
+    assert!(!images.join("lpv-voxels.png").exists());
+    // A run without the grid into the same folder finds its rows there.
+    let journal = dir.join("rows.jsonl");
+    let before = lines(&journal);
+    let rows = run("none");
+    assert_eq!(lines(&journal), before);
+    assert_eq!(rows.len(), 1 + hisr + lpv);
+    assert!(rows.iter().all(|r| r["visibility"] == "none"));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

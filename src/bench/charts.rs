@@ -7,6 +7,7 @@ use super::rows::Row;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// Registers the embedded font as "sans-serif" (once; later calls do nothing).
@@ -124,10 +125,84 @@ fn front(sorted: &[(f64, f64)]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Panels of (x, y) curves, one per method over its sweep, log-log: a line
-/// along the method's front (`front`), a dot per point. With `reference`,
-/// the dense reference's y is a dashed line across each panel (against
-/// the truth: the model error, which no VPL method goes far below).
+/// A curve of the charts: a method's rows of one visibility (`Row::visibility`).
+#[derive(Clone, Copy, PartialEq)]
+struct Series<'a> {
+    method: &'a str,
+    visibility: &'a str,
+}
+
+impl Series<'_> {
+    fn of(r: &Row) -> Series<'_> {
+        Series {
+            method: &r.method,
+            visibility: &r.visibility,
+        }
+    }
+
+    /// Whether it renders with indirect visibility: drawn dashed, its dots
+    /// hollow, in its method's colour.
+    fn with_visibility(&self) -> bool {
+        !matches!(self.visibility, "" | "none")
+    }
+
+    /// Its legend entry: `hisr`, `hisr + voxels 64`.
+    fn name(&self) -> String {
+        super::visibility::series_name(self.method, self.visibility)
+    }
+
+    /// Its line through `points`.
+    fn line<DB: DrawingBackend>(
+        &self,
+        chart: &mut ChartContext<DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
+        points: Vec<(f64, f64)>,
+    ) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let style = method_color(self.method).stroke_width(2);
+        match self.with_visibility() {
+            true => chart.draw_series(DashedLineSeries::new(points, 7, 4, style)),
+            false => chart.draw_series(LineSeries::new(points, style)),
+        }
+        .map_err(|e| anyhow!("{e}"))?;
+        Ok(())
+    }
+
+    /// Its dot at `p`.
+    fn dot<C>(&self, p: C) -> Circle<C, i32> {
+        let color = method_color(self.method);
+        match self.with_visibility() {
+            true => Circle::new(p, 3, color.stroke_width(1)),
+            false => Circle::new(p, 3, color.filled()),
+        }
+    }
+}
+
+/// The grid of a chart: a cell per scene and one for the legend, which so
+/// never covers a point or a bar.
+fn legend_grid(scenes: usize) -> (usize, usize) {
+    grid(scenes + 1)
+}
+
+/// `items` in order of their method's first appearance, stably: a method's
+/// rows of every visibility side by side, as `rows` orders them (without
+/// visibility first).
+fn by_method<T>(items: &mut [T], method: impl Fn(&T) -> &str) {
+    let mut order: Vec<String> = vec![];
+    for i in items.iter() {
+        if !order.iter().any(|m| m == method(i)) {
+            order.push(method(i).to_string());
+        }
+    }
+    items.sort_by_key(|i| order.iter().position(|m| m == method(i)));
+}
+
+/// Panels of (x, y) curves, one per method and visibility over its sweep,
+/// log-log: a line along its front (`front`; dashed with visibility), a dot
+/// per point; the legend in a cell of its own. With `reference`, each dense
+/// reference's y (one per visibility) is a dashed line across each panel
+/// (against the truth: the model error, which no VPL method goes far below).
 fn curves<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Row],
@@ -144,14 +219,9 @@ where
     let root = root
         .titled(title, ("sans-serif", 22))
         .map_err(|e| anyhow!("{e}"))?;
-    let (r, c) = grid(scenes.len());
-    let panels = root.split_evenly((r, c));
-    // One legend for every panel in a cell the grid leaves free; without
-    // one, each panel's own, in its corner with the fewest points under it.
-    let all_methods = methods_in(rows);
-    let free = panels.get(scenes.len());
-    if let Some(cell) = free {
-        legend_panel(cell, &all_methods)?;
+    let panels = root.split_evenly(legend_grid(scenes.len()));
+    if let Some(cell) = panels.get(scenes.len()) {
+        legend_panel(cell, &series_in(rows))?;
     }
     for (scene, panel) in scenes.iter().zip(panels.iter()) {
         let pts: Vec<&Row> = rows
@@ -161,12 +231,20 @@ where
                 row.indirect_ms.is_some_and(|v| v > 0.0) && y(row).is_some_and(|v| v > 0.0)
             })
             .collect();
-        let floor = rows
+        let floors: Vec<(String, f64)> = rows
             .iter()
             .filter(|row| reference && &row.scene == scene && row.method == "reference")
-            .find_map(|row| y(row).filter(|v| *v > 0.0));
+            .filter_map(|row| {
+                let name = super::visibility::series_name("dense reference", &row.visibility);
+                Some((name, y(row).filter(|v| *v > 0.0)?))
+            })
+            .collect();
         let xr = log_range(pts.iter().filter_map(|r| r.indirect_ms));
-        let yr = log_range(pts.iter().filter_map(|r| y(r)).chain(floor));
+        let yr = log_range(
+            pts.iter()
+                .filter_map(|r| y(r))
+                .chain(floors.iter().map(|f| f.1)),
+        );
         let mut chart = ChartBuilder::on(panel)
             .caption(scene, ("sans-serif", 18))
             .margin(8)
@@ -185,93 +263,81 @@ where
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
-        let mut methods: Vec<&str> = vec![];
+        let mut series: Vec<Series> = vec![];
         for p in &pts {
-            if !methods.contains(&p.method.as_str()) {
-                methods.push(&p.method);
+            if !series.contains(&Series::of(p)) {
+                series.push(Series::of(p));
             }
         }
-        let points: Vec<(f64, f64)> = pts
-            .iter()
-            .filter_map(|p| Some((p.indirect_ms?, y(p)?)))
-            .collect();
-        let corner = emptiest_corner(&points, (&xr, &yr), methods.len());
-        for m in methods {
-            let color = method_color(m);
+        for s in series {
             let mut line: Vec<(f64, f64)> = pts
                 .iter()
-                .filter(|p| p.method == m)
+                .filter(|p| Series::of(p) == s)
                 .filter_map(|p| Some((p.indirect_ms?, y(p)?)))
                 .collect();
             line.sort_by(|a, b| a.0.total_cmp(&b.0));
+            s.line(&mut chart, front(&line))?;
             chart
-                .draw_series(LineSeries::new(front(&line), color.stroke_width(2)))
-                .map_err(|e| anyhow!("{e}"))?
-                .label(m)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .draw_series(line.iter().map(|&p| s.dot(p)))
                 .map_err(|e| anyhow!("{e}"))?;
         }
-        if let Some(v) = floor {
+        for (name, v) in floors {
             let ends = vec![(xr.start, v), (xr.end, v)];
             chart
                 .draw_series(DashedLineSeries::new(ends, 6, 4, BLACK.stroke_width(1)))
                 .map_err(|e| anyhow!("{e}"))?;
+            // Above its line: below it, the lowest would meet the axis.
+            let font = ("sans-serif", 11).into_font().color(&BLACK);
+            let above = font.pos(Pos::new(HPos::Left, VPos::Bottom));
             chart
                 .draw_series(std::iter::once(Text::new(
-                    format!("dense reference {}", short(v)),
+                    format!("{name} {}", short(v)),
                     (xr.start * 1.05, v),
-                    ("sans-serif", 11).into_font().color(&BLACK),
+                    above,
                 )))
-                .map_err(|e| anyhow!("{e}"))?;
-        }
-        if free.is_none() {
-            chart
-                .configure_series_labels()
-                .position(corner)
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 11))
-                .draw()
                 .map_err(|e| anyhow!("{e}"))?;
         }
     }
     Ok(())
 }
 
-/// Every method of `rows` but the reference, in first appearance.
-fn methods_in(rows: &[Row]) -> Vec<&str> {
-    let mut out: Vec<&str> = vec![];
+/// Every series of `rows` but the references', in first appearance, a
+/// method's side by side.
+fn series_in(rows: &[Row]) -> Vec<Series<'_>> {
+    let mut out: Vec<Series> = vec![];
     for r in rows {
-        if r.method != "reference" && !out.contains(&r.method.as_str()) {
-            out.push(&r.method);
+        if r.method != "reference" && !out.contains(&Series::of(r)) {
+            out.push(Series::of(r));
         }
     }
+    by_method(&mut out, |s| s.method);
     out
 }
 
-/// The legend of `methods`, drawn alone in a free cell of the grid.
-fn legend_panel<DB: DrawingBackend>(cell: &DrawingArea<DB, Shift>, methods: &[&str]) -> Result<()>
+/// The legend of `series`, drawn alone in a free cell of the grid: a
+/// series with visibility dashed with a hollow dot, as its curve.
+fn legend_panel<DB: DrawingBackend>(cell: &DrawingArea<DB, Shift>, series: &[Series]) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
     let (w, h) = cell.dim_in_pixel();
-    let (x0, y0) = (w as i32 / 4, (h as i32 - 22 * methods.len() as i32) / 2);
-    for (i, m) in methods.iter().enumerate() {
-        let y = y0 + 22 * i as i32;
-        let color = method_color(m);
-        cell.draw(&PathElement::new(
-            vec![(x0, y), (x0 + 28, y)],
-            color.stroke_width(3),
-        ))
-        .map_err(|e| anyhow!("{e}"))?;
-        cell.draw(&Circle::new((x0 + 14, y), 3, color.filled()))
+    let step = (h as i32 / (series.len() as i32 + 1)).clamp(12, 22);
+    let (x0, y0) = (w as i32 / 6, (h as i32 - step * series.len() as i32) / 2);
+    for (i, s) in series.iter().enumerate() {
+        let y = y0 + step * i as i32;
+        let style = method_color(s.method).stroke_width(3);
+        let dashes = match s.with_visibility() {
+            true => vec![(x0, x0 + 9), (x0 + 19, x0 + 28)],
+            false => vec![(x0, x0 + 28)],
+        };
+        for (a, b) in dashes {
+            cell.draw(&PathElement::new(vec![(a, y), (b, y)], style))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        cell.draw(&s.dot((x0 + 14, y)))
             .map_err(|e| anyhow!("{e}"))?;
         cell.draw(&Text::new(
-            m.to_string(),
+            s.name(),
             (x0 + 38, y - 8),
             ("sans-serif", 15).into_font(),
         ))
@@ -280,42 +346,10 @@ where
     Ok(())
 }
 
-/// Of a log-log panel's four corners, the one whose legend box (about a third
-/// of the width, a line per method) covers the fewest of `points`.
-fn emptiest_corner(
-    points: &[(f64, f64)],
-    (xr, yr): (&std::ops::Range<f64>, &std::ops::Range<f64>),
-    methods: usize,
-) -> SeriesLabelPosition {
-    let unit =
-        |v: f64, r: &std::ops::Range<f64>| (v.ln() - r.start.ln()) / (r.end.ln() - r.start.ln());
-    let (bw, bh) = (0.36, (0.05 * methods as f64 + 0.04).min(0.9));
-    let corners = [
-        (SeriesLabelPosition::UpperRight, 1.0 - bw, 1.0 - bh),
-        (SeriesLabelPosition::LowerLeft, 0.0, 0.0),
-        (SeriesLabelPosition::UpperLeft, 0.0, 1.0 - bh),
-        (SeriesLabelPosition::LowerRight, 1.0 - bw, 0.0),
-    ];
-    let covered = |&(_, x, y): &(SeriesLabelPosition, f64, f64)| {
-        points
-            .iter()
-            .filter(|&&(px, py)| {
-                let (u, v) = (unit(px, xr), unit(py, yr));
-                u >= x - 0.02 && u <= x + bw + 0.02 && v >= y - 0.02 && v <= y + bh + 0.02
-            })
-            .count()
-    };
-    let best = corners
-        .iter()
-        .min_by_key(|c| covered(c))
-        .expect("four corners");
-    best.0.clone()
-}
-
 /// `speed_vs_error.svg/.png`: indirect ms against relative RMSE of the
 /// indirect image, one panel per scene (section 6.5).
 pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
-    let (r, c) = grid(scenes.len());
+    let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 400 * r as u32 + 40);
     let title = "indirect time against error (log-log; lower left is better)";
     let y = |r: &Row| Some(r.rel_rmse_indirect);
@@ -351,7 +385,7 @@ pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
 /// indirect image against the path-traced truth, over the pixels its mask
 /// keeps, with the dense reference's (section 6.6).
 pub fn speed_vs_truth(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
-    let (r, c) = grid(scenes.len());
+    let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 400 * r as u32 + 40);
     let title = "indirect time against error from the path-traced truth (log-log)";
     let y = |r: &Row| r.truth.rel_rmse_indirect;
@@ -366,7 +400,7 @@ pub fn speed_vs_truth(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
 
 /// `flicker.svg/.png`: flicker (section 6.3) against indirect ms.
 pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
-    let (r, c) = grid(scenes.len());
+    let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 400 * r as u32 + 40);
     let title = "flicker against indirect time (log-log; lower left is better)";
     let y = |r: &Row| r.flicker;
@@ -394,30 +428,41 @@ where
             ("sans-serif", 22),
         )
         .map_err(|e| anyhow!("{e}"))?;
-    let (r, c) = grid(scenes.len());
-    let panels = root.split_evenly((r, c));
-    let passes = super::rows::pass_names(rows);
+    let panels = root.split_evenly(legend_grid(scenes.len()));
+    // The passes of the bars (the references' own are not drawn).
+    let is_bar = |r: &&Row| r.is_default && r.method != "reference";
+    let passes: Vec<String> = super::rows::pass_names(rows)
+        .into_iter()
+        .filter(|p| rows.iter().filter(is_bar).any(|r| r.passes.contains_key(p)))
+        .collect();
     let palette = |i: usize| Palette99::pick(i).to_rgba();
+    if let Some(cell) = panels.get(scenes.len()) {
+        pass_legend(cell, &passes, &palette)?;
+    }
     for (scene, panel) in scenes.iter().zip(panels.iter()) {
-        let bars: Vec<&Row> = rows
+        let mut bars: Vec<&Row> = rows
             .iter()
-            .filter(|r| &r.scene == scene && r.is_default && r.method != "reference")
+            .filter(|r| &r.scene == scene)
+            .filter(is_bar)
             .collect();
+        by_method(&mut bars, |r| &r.method);
         let max = bars
             .iter()
             .filter_map(|r| r.total_ms)
             .fold(1e-3f64, f64::max)
             * 1.1;
         let n = bars.len().max(1);
-        // Horizontal bars: method names fit on the left.
+        // Horizontal bars: names (a method's, with its visibility where it
+        // has one: `hisr + voxels 64`) fit on the left.
+        let names: Vec<String> = bars.iter().map(|r| Series::of(r).name()).collect();
+        let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
         let mut chart = ChartBuilder::on(panel)
             .caption(scene, ("sans-serif", 18))
             .margin(8)
             .x_label_area_size(36)
-            .y_label_area_size(130)
+            .y_label_area_size((7 * longest as u32 + 12).max(130))
             .build_cartesian_2d(0f64..max, 0f64..n as f64)
             .map_err(|e| anyhow!("{e}"))?;
-        let names: Vec<String> = bars.iter().map(|r| r.method.clone()).collect();
         chart
             .configure_mesh()
             .disable_y_mesh()
@@ -452,29 +497,44 @@ where
             if rects.is_empty() {
                 continue;
             }
-            chart
-                .draw_series(rects)
-                .map_err(|e| anyhow!("{e}"))?
-                .label(pass.as_str())
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 10, y + 5)], color.filled())
-                });
+            chart.draw_series(rects).map_err(|e| anyhow!("{e}"))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 10))
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
+}
+
+/// The legend of the per-pass chart, alone in a free cell: a swatch per pass.
+fn pass_legend<DB: DrawingBackend>(
+    cell: &DrawingArea<DB, Shift>,
+    passes: &[String],
+    palette: &dyn Fn(usize) -> RGBAColor,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let (w, h) = cell.dim_in_pixel();
+    let step = (h as i32 / (passes.len() as i32 + 1)).clamp(12, 22);
+    let (x0, y0) = (w as i32 / 6, (h as i32 - step * passes.len() as i32) / 2);
+    for (i, pass) in passes.iter().enumerate() {
+        let y = y0 + step * i as i32;
+        cell.draw(&Rectangle::new(
+            [(x0, y - 6), (x0 + 14, y + 6)],
+            palette(i).filled(),
+        ))
+        .map_err(|e| anyhow!("{e}"))?;
+        cell.draw(&Text::new(
+            pass.clone(),
+            (x0 + 24, y - 8),
+            ("sans-serif", 15).into_font(),
+        ))
+        .map_err(|e| anyhow!("{e}"))?;
     }
     Ok(())
 }
 
 /// `passes.svg/.png`.
 pub fn passes(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
-    let (r, c) = grid(scenes.len());
+    let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 460 * r as u32 + 40);
     both(
         &dir.join("passes"),
@@ -484,42 +544,59 @@ pub fn passes(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     )
 }
 
-/// `gallery.png`: per scene two rows, every method's image at its default
-/// (the middle animation frame) and its FLIP heat map against the reference,
-/// with the reference first; labelled with method and error.
-pub fn gallery(dir: &Path, rows: &[Row], scenes: &[String], methods: &[&str]) -> Result<()> {
+/// `gallery.png`: per scene and visibility (`visibilities`: each's label and
+/// its images' suffix, `Plan::image_suffix`) two rows, every method's image
+/// at its default (the middle animation frame) and its FLIP heat map against
+/// the reference of that visibility, with the reference first; labelled
+/// with method and error. A method that reads no visibility has blank cells
+/// in the rows with visibility, and says so.
+pub fn gallery(
+    dir: &Path,
+    rows: &[Row],
+    scenes: &[String],
+    methods: &[&str],
+    visibilities: &[(String, &str)],
+) -> Result<()> {
     let load = |p: &Path| -> Option<image::RgbaImage> { Some(image::open(p).ok()?.to_rgba8()) };
     let mut cells: Vec<Vec<(String, Option<image::RgbaImage>)>> = vec![];
     let (mut cw, mut ch) = (64u32, 64u32);
     for s in scenes {
         let images = dir.join("images").join(s);
-        let mut top = vec![(
-            format!("{s}: reference"),
-            load(&images.join("reference.png")),
-        )];
-        let mut bottom = vec![("FLIP: black 0, white 1".to_string(), None)];
-        for m in methods {
-            let row = rows
-                .iter()
-                .find(|r| &r.scene == s && r.method == *m && r.is_default);
-            let label = match row {
-                Some(r) => format!("{m}\n{}, RMSE {:.3}", r.label, r.rel_rmse_indirect),
-                None => format!("{m}: not run"),
-            };
-            top.push((label, load(&images.join(format!("{m}.png")))));
-            let flip = row
-                .map(|r| format!("FLIP {:.3}", r.flip))
-                .unwrap_or_default();
-            bottom.push((flip, load(&images.join(format!("{m}-error.png")))));
-        }
-        for (_, img) in top.iter().chain(&bottom) {
-            if let Some(i) = img {
-                cw = cw.max(i.width());
-                ch = ch.max(i.height());
+        for (v, suffix) in visibilities {
+            let reference = super::visibility::series_name("reference", v);
+            let mut top = vec![(
+                format!("{s}: {reference}"),
+                load(&images.join(format!("reference{suffix}.png"))),
+            )];
+            let mut bottom = vec![("FLIP: black 0, white 1".to_string(), None)];
+            for m in methods {
+                let name = super::visibility::series_name(m, v);
+                let row = rows.iter().find(|r| {
+                    &r.scene == s && r.method == *m && &r.visibility == v && r.is_default
+                });
+                let reads = crate::methods::by_name(m).is_ok_and(|d| d.reads_visibility());
+                let label = match row {
+                    Some(r) => format!("{name}\n{}, RMSE {:.3}", r.label, r.rel_rmse_indirect),
+                    None if !reads && !matches!(v.as_str(), "" | "none") => {
+                        format!("{m}: reads no\nvisibility")
+                    }
+                    None => format!("{name}: not run"),
+                };
+                top.push((label, load(&images.join(format!("{m}{suffix}.png")))));
+                let flip = row
+                    .map(|r| format!("FLIP {:.3}", r.flip))
+                    .unwrap_or_default();
+                bottom.push((flip, load(&images.join(format!("{m}{suffix}-error.png")))));
             }
+            for (_, img) in top.iter().chain(&bottom) {
+                if let Some(i) = img {
+                    cw = cw.max(i.width());
+                    ch = ch.max(i.height());
+                }
+            }
+            cells.push(top);
+            cells.push(bottom);
         }
-        cells.push(top);
-        cells.push(bottom);
     }
     // Small renders are shown enlarged so labels fit.
     let scale = (240 / cw).max(1);

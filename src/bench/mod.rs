@@ -6,6 +6,7 @@
 
 pub mod charts;
 pub mod flip;
+mod measure;
 pub mod metrics;
 pub mod report;
 pub mod rows;
@@ -13,15 +14,16 @@ pub mod scenes;
 pub mod sweep;
 pub mod truth;
 mod truth_cache;
+pub mod visibility;
 
-use crate::readback::Readback;
-use crate::renderer::{FrameStats, Renderer};
+use crate::passes::visibility_grid::Visibility;
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::{Gpu, GpuOptions};
 use anyhow::{bail, Context as _, Result};
+use measure::{run_scene, Pending};
 use rows::Row;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use sweep::Config;
 
 /// What `isr bench` runs (the CLI's flags; `cargo bench` fills it in code).
@@ -63,13 +65,22 @@ pub struct BenchArgs {
     /// stress scenes; quick 0.1). 0 traces no truth.
     #[arg(long)]
     pub truth_noise: Option<f64>,
+    /// Indirect visibility (comma-separated): every method renders with
+    /// `none`, and every method that reads visibility (the gathers, the
+    /// splats, the dense reference; not lpv) again with each further entry,
+    /// against a dense reference with the same visibility. `voxels`: the
+    /// grid of --visibility-grid. Default: none,voxels (quick: none).
+    /// `exact` is refused (CPU minutes a frame; `isr render --method
+    /// reference --visibility exact`).
+    #[arg(long, value_delimiter = ',', num_args = 1.., value_name = "none|voxels")]
+    pub visibility: Vec<String>,
     /// Vulkan device index (`isr devices`).
     #[arg(long)]
     pub device: Option<usize>,
     /// Parameters every point renders with, where its sweep does not set
     /// them (`--levels 4`: every multiresolution method at 4 levels).
     #[command(flatten)]
-    pub params: crate::methods::ParamArgs,
+    pub params: crate::methods::ParamArgsButVisibility,
 }
 
 impl Default for BenchArgs {
@@ -85,6 +96,7 @@ impl Default for BenchArgs {
             out_dir: "out/bench".into(),
             quick: false,
             truth_noise: None,
+            visibility: vec![],
             device: None,
             params: Default::default(),
         }
@@ -104,6 +116,9 @@ pub struct Plan {
     pub device: Option<usize>,
     /// The truth's noise target; `None`: no truth.
     pub truth_noise: Option<f64>,
+    /// The visibility axis (`--visibility`; `visibility::parse`); a pass's
+    /// plan (`Plan::passes`): its one visibility.
+    pub visibilities: Vec<Visibility>,
 }
 
 /// A scene of the run: its name, how it is made, its animation window, and
@@ -234,22 +249,32 @@ impl BenchArgs {
                 "--truth-noise {truth_noise}: the path-traced truth's noise target must be at least 0 (no truth) and under 1; 0.02 is the default"
             );
         }
+        let visibilities = visibility::parse(&self.visibility, q)?;
+        let base = RenderSettings {
+            width,
+            height,
+            rsm_resolution: rsm,
+            params: self.params.0.clone(),
+            ..RenderSettings::DEFAULT
+        };
+        // Each pass sets its own (`Plan::passes`); a grid out of range is
+        // refused before any work.
+        let base = visibility::with(&base, Visibility::None);
+        if visibilities.contains(&Visibility::Voxels) {
+            use crate::settings::params::AnyParam as _;
+            crate::passes::visibility_grid::GRID.check(&base)?;
+        }
         Ok(Plan {
             scenes: specs,
             methods,
-            base: RenderSettings {
-                width,
-                height,
-                rsm_resolution: rsm,
-                params: self.params.0.clone(),
-                ..RenderSettings::DEFAULT
-            },
+            base,
             frames,
             timing_frames,
             quick: q,
             out_dir: self.out_dir.clone(),
             device: self.device,
             truth_noise: (truth_noise > 0.0).then_some(truth_noise),
+            visibilities,
         })
     }
 }
@@ -299,14 +324,18 @@ impl Plan {
         )
     }
 
-    /// Every key this run produces, in report order.
-    pub fn keys(&self) -> Vec<String> {
+    /// Every key this run produces with its rows' visibility, in report
+    /// order: per scene, each pass's reference and points.
+    pub fn keys(&self) -> Vec<(String, String)> {
         let mut keys = vec![];
         for s in &self.scenes {
-            let p = self.for_scene(s);
-            keys.push(p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL));
-            for c in p.configs() {
-                keys.push(p.key(&s.name, c.method.name(), &c.label(&p.base)));
+            for p in self.for_scene(s).passes() {
+                let v = p.visibility_label();
+                keys.push((p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL), v.clone()));
+                for c in p.configs() {
+                    let k = p.key(&s.name, c.method.name(), &c.label(&p.base));
+                    keys.push((k, v.clone()));
+                }
             }
         }
         keys
@@ -316,28 +345,6 @@ impl Plan {
 const REFERENCE_LABEL: &str = "every RSM texel";
 const REFERENCE: Method = crate::methods::reference::KEY;
 
-/// One frame of the dense reference, what every method is compared with,
-/// and of the path-traced truth where points are measured.
-struct RefFrame {
-    indirect: Vec<[f32; 4]>,
-    final_radiance: Vec<[f32; 4]>,
-    mask: Vec<bool>,
-    display: Vec<u8>,
-    truth: Option<TruthFrame>,
-}
-
-/// The path-traced truth's indirect image and the pixels it is compared on.
-struct TruthFrame {
-    indirect: Vec<[f32; 4]>,
-    mask: Vec<bool>,
-}
-
-/// The total the GPU allocator has handed out, in bytes.
-fn allocated_bytes(gpu: &Gpu) -> Option<i64> {
-    let a = gpu.shared.allocator.lock().ok()?;
-    Some(a.generate_report().total_allocated_bytes as i64)
-}
-
 /// What a finished run returns (the rows of this plan, in order).
 pub struct Outcome {
     pub rows: Vec<Row>,
@@ -345,18 +352,30 @@ pub struct Outcome {
     pub driver: String,
 }
 
-/// The images of `spec` that the gallery shows, written by [`run_scene`] at
-/// the middle animation frame: the reference's and, per method with a
-/// default point, that point's image and FLIP map.
+/// The images of `spec` that the gallery shows, written by
+/// [`measure::run_scene`] at the middle animation frame for pass `plan`
+/// (`Plan::passes`): the reference's and, per method with a default point,
+/// that point's image and FLIP map.
 fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
     let images = plan.out_dir.join("images").join(&spec.name);
-    let mut files = vec![images.join("reference.png")];
+    let mut files = vec![images.join(reference_image(plan))];
     for c in plan.configs().iter().filter(|c| c.is_default(&plan.base)) {
-        let m = c.method.name();
-        files.push(images.join(format!("{m}.png")));
-        files.push(images.join(format!("{m}-error.png")));
+        files.extend(point_images(plan, c).map(|n| images.join(n)));
     }
     files
+}
+
+/// The gallery image of pass `plan`'s reference: `reference.png`, or with
+/// the grid `reference-voxels.png`.
+fn reference_image(plan: &Plan) -> String {
+    format!("reference{}.png", plan.image_suffix())
+}
+
+/// The gallery images of point `c` of pass `plan`, its image and its FLIP
+/// map: `hisr.png` and `hisr-error.png`, or `hisr-voxels.png` ...
+fn point_images(plan: &Plan, c: &Config) -> [String; 2] {
+    let (m, v) = (c.method.name(), plan.image_suffix());
+    [format!("{m}{v}.png"), format!("{m}{v}-error.png")]
 }
 
 /// Whether the gallery images of point `c` of `spec` (or, without one, the
@@ -364,11 +383,8 @@ fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
 fn images_present(plan: &Plan, spec: &SceneSpec, c: Option<&Config>) -> bool {
     let images = plan.out_dir.join("images").join(&spec.name);
     let names = match c {
-        None => vec!["reference.png".to_string()],
-        Some(c) => {
-            let m = c.method.name();
-            vec![format!("{m}.png"), format!("{m}-error.png")]
-        }
+        None => vec![reference_image(plan)],
+        Some(c) => point_images(plan, c).to_vec(),
     };
     names.iter().all(|n| images.join(n).is_file())
 }
@@ -390,7 +406,9 @@ fn check_outputs(plan: &Plan) -> Result<()> {
         .map(|n| dir.join(n))
         .collect();
     for s in &plan.scenes {
-        files.extend(gallery_images(&plan.for_scene(s), s));
+        for p in plan.for_scene(s).passes() {
+            files.extend(gallery_images(&p, s));
+        }
     }
     for f in files {
         crate::output::check_output("bench output", &f, Some(&remedy))?;
@@ -416,73 +434,41 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
         ..Default::default()
     })?;
     crate::bench::charts::register_font();
-    // Work units: one per frame rendered (reference and every pending point).
-    let mut pending: Vec<(SceneSpec, Pending)> = vec![];
+    // Work units: one per frame rendered (each pass's reference and every
+    // pending point) and per frame traced (the truth, once per scene).
+    let mut pending: Vec<(SceneSpec, Vec<(Plan, Pending)>)> = vec![];
     let mut units = 0u64;
-    let run_plan = plan;
-    for s in &run_plan.scenes {
-        let plan = &run_plan.for_scene(s);
-        let configs = plan.configs();
-        let image_frames = plan.frames / 2 + 1;
-        let is_done =
-            |c: &Config| done.contains(&plan.key(&s.name, c.method.name(), &c.label(&plan.base)));
-        let todo: Vec<Config> = configs.iter().filter(|c| !is_done(c)).cloned().collect();
-        let redraw: Vec<Config> = configs
-            .iter()
-            .filter(|c| is_done(c) && c.is_default(&plan.base))
-            .filter(|c| !images_present(plan, s, Some(c)))
-            .cloned()
+    for s in &plan.scenes {
+        let scene_plan = plan.for_scene(s);
+        let passes: Vec<(Plan, Pending)> = scene_plan
+            .passes()
+            .into_iter()
+            .filter_map(|p| Pending::of(&p, s, &done).map(|w| (p, w)))
             .collect();
-        let ref_row = !done.contains(&plan.key(&s.name, "reference", REFERENCE_LABEL));
-        if todo.is_empty() && !ref_row && redraw.is_empty() && images_present(plan, s, None) {
+        if passes.is_empty() {
             continue;
         }
-        // The reference's every frame where a point is measured; up to the
-        // gallery's frame where only images are drawn again.
-        let ref_frames = if todo.is_empty() && !ref_row {
-            image_frames
-        } else {
-            plan.frames
-        };
-        // The truth is traced with the reference where anything is measured.
-        let truth_frames = if plan.truth_noise.is_none() || (todo.is_empty() && !ref_row) {
-            0
-        } else {
-            plan.frames
-        };
-        units += ref_frames as u64
-            + truth_frames as u64
-            + plan.frames as u64 * todo.len() as u64
-            + image_frames as u64 * redraw.len() as u64;
-        pending.push((
-            s.clone(),
-            Pending {
-                todo,
-                redraw,
-                ref_row,
-                ref_frames,
-            },
-        ));
+        if scene_plan.truth_noise.is_some() && passes.iter().any(|(_, w)| w.measures()) {
+            units += scene_plan.frames as u64;
+        }
+        units += passes.iter().map(|(p, w)| w.frames(p)).sum::<u64>();
+        pending.push((s.clone(), passes));
     }
     let bar = crate::progress::bar(units, "frames");
-    for (spec, work) in &pending {
+    for (spec, passes) in &pending {
         let scene = spec.load(&gpu)?;
-        run_scene(
-            &plan.for_scene(spec),
-            &gpu,
-            spec,
-            &scene,
-            work,
-            &journal,
-            &bar,
-        )?;
+        run_scene(&gpu, spec, &scene, passes, &journal, &bar)?;
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;
+    // Rows journalled before the axis have no visibility: their key's.
     let rows: Vec<Row> = plan
         .keys()
-        .iter()
-        .filter_map(|k| all.iter().rev().find(|r| &r.key == k).cloned())
+        .into_iter()
+        .filter_map(|(k, visibility)| {
+            let r = all.iter().rev().find(|r| r.key == k).cloned()?;
+            Some(Row { visibility, ..r })
+        })
         .collect();
     let outcome = Outcome {
         rows,
@@ -491,18 +477,6 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     };
     report::write_all(plan, &outcome)?;
     Ok(outcome)
-}
-
-/// What a scene of the run still needs.
-struct Pending {
-    /// Points to measure (not in the journal).
-    todo: Vec<Config>,
-    /// Default points in the journal whose gallery images are missing.
-    redraw: Vec<Config>,
-    /// Whether the reference's row is to be written.
-    ref_row: bool,
-    /// Animation frames of the reference to render.
-    ref_frames: u32,
 }
 
 /// `isr bench`: plans, runs, prints where the results are and the ratios.
@@ -520,301 +494,4 @@ pub fn cli(args: &BenchArgs) -> Result<()> {
 /// Animation time of frame `k`.
 fn frame_time(spec: &SceneSpec, k: u32) -> f32 {
     spec.start + k as f32 / spec.fps
-}
-
-fn run_scene(
-    plan: &Plan,
-    gpu: &Gpu,
-    spec: &SceneSpec,
-    scene: &Scene,
-    work: &Pending,
-    journal: &Path,
-    bar: &indicatif::ProgressBar,
-) -> Result<()> {
-    let ref_row = work.ref_row;
-    let images = plan.out_dir.join("images").join(&spec.name);
-    let with_truth = plan.truth_noise.is_some() && (ref_row || !work.todo.is_empty());
-    // The dense reference of every frame, once, and its path-traced truth.
-    let mut refs = Vec::with_capacity(plan.frames as usize);
-    let mut ref_stats = FrameStats::default();
-    let mut model = rows::TruthErrors::default();
-    {
-        let settings = settings_of(plan, REFERENCE);
-        let mut r = Renderer::new(gpu, scene, &settings)?;
-        for k in 0..work.ref_frames {
-            bar.set_message(format!(
-                "{}: reference, frame {}/{}",
-                spec.name,
-                k + 1,
-                work.ref_frames
-            ));
-            let state = scene.pose_at(frame_time(spec, k))?;
-            r.update(&state)?;
-            let last = k + 1 == plan.frames;
-            ref_stats.extend(r.render_frames_counting(1, last, |_| {})?);
-            let out = r.readback()?;
-            let truth = if with_truth {
-                let posed = state.pose(scene);
-                let t = truth_cache::frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
-                // Only the reference's row keeps the floor: minutes of rays
-                // when not cached, so not traced for a row already measured.
-                if ref_row && k == plan.frames / 2 {
-                    let exact = truth_cache::model_floor(plan, spec, k, &posed, &mut r, &out, bar)?;
-                    model.floor = Some(metrics::relative_rmse(
-                        &exact,
-                        &t.image.indirect,
-                        &t.mask.mask,
-                    ));
-                }
-                let n = plan.frames as f64;
-                let e = metrics::relative_rmse(&out.indirect, &t.image.indirect, &t.mask.mask);
-                let add = |v: &mut Option<f64>, x: f64| *v = Some(v.unwrap_or(0.0) + x / n);
-                add(&mut model.rel_rmse_indirect, e);
-                add(&mut model.spp, t.spp as f64);
-                add(&mut model.noise, t.noise);
-                add(&mut model.left_out, t.mask.left_out());
-                bar.inc(1);
-                Some(TruthFrame {
-                    indirect: t.image.indirect,
-                    mask: t.mask.mask,
-                })
-            } else {
-                None
-            };
-            if k == plan.frames / 2 {
-                crate::output::write_png(
-                    &images.join("reference.png"),
-                    out.width,
-                    out.height,
-                    &out.display,
-                )?;
-            }
-            refs.push(RefFrame {
-                mask: metrics::geometry_mask(&out.position),
-                indirect: out.indirect,
-                final_radiance: out.final_radiance,
-                display: out.display,
-                truth,
-            });
-            bar.inc(1);
-        }
-    }
-    if ref_row {
-        let mut row = timing_row(plan, spec, &settings_of(plan, REFERENCE), &ref_stats);
-        row.label = REFERENCE_LABEL.into();
-        row.key = plan.key(&spec.name, "reference", REFERENCE_LABEL);
-        row.is_default = true;
-        row.truth = model;
-        rows::append(journal, &row)?;
-    }
-    // The allocator's total without any indirect method, to subtract.
-    let baseline = {
-        let _none = Renderer::new(gpu, scene, &settings_of(plan, crate::methods::none::KEY))?;
-        allocated_bytes(gpu)
-    };
-    let points = work.todo.iter().map(|c| (c, true));
-    for (c, measure) in points.chain(work.redraw.iter().map(|c| (c, false))) {
-        // A point drawn again for its images renders up to their frame.
-        let frames = if measure {
-            plan.frames
-        } else {
-            plan.frames / 2 + 1
-        };
-        let settings = c.settings(&plan.base);
-        let label = c.label(&plan.base);
-        let mut r = Renderer::new(gpu, scene, &settings)
-            .with_context(|| format!("{} {label} on {}", c.method.name(), spec.name))?;
-        let memory = match (allocated_bytes(gpu), baseline) {
-            (Some(a), Some(b)) => Some(a - b),
-            _ => None,
-        };
-        let mut stats = FrameStats::default();
-        let mut flicker = metrics::Flicker::new(plan.base.width, plan.base.height);
-        let mut flicker_final = metrics::Flicker::new(plan.base.width, plan.base.height);
-        let (mut e_ind, mut e_fin, mut e_flip) = (0.0, 0.0, 0.0);
-        let mut e_truth = None;
-        let mut evals = None;
-        for k in 0..frames {
-            bar.set_message(format!(
-                "{}: {} {label}, frame {}/{frames}{}",
-                spec.name,
-                c.method.name(),
-                k + 1,
-                if measure { "" } else { " (images only)" }
-            ));
-            r.update(&scene.pose_at(frame_time(spec, k))?)?;
-            let n = if k == 0 && measure {
-                plan.timing_frames
-            } else {
-                1
-            };
-            // Every frame times but the run's last, which counts (`Profiler`).
-            let last = k + 1 == plan.frames;
-            stats.extend(r.render_frames_counting(n, last, |_| {})?);
-            let out = r.readback()?;
-            let reference = &refs[k as usize];
-            e_ind += metrics::relative_rmse(&out.indirect, &reference.indirect, &reference.mask);
-            if let Some(t) = &reference.truth {
-                let e = metrics::relative_rmse(&out.indirect, &t.indirect, &t.mask);
-                e_truth = Some(e_truth.unwrap_or(0.0) + e);
-            }
-            e_fin += metrics::relative_rmse(
-                &out.final_radiance,
-                &reference.final_radiance,
-                &reference.mask,
-            );
-            let map = flip::flip_map(
-                &reference.display,
-                &out.display,
-                out.width,
-                out.height,
-                flip::PIXELS_PER_DEGREE,
-            )?;
-            e_flip += flip::mean_flip(&map, &reference.mask);
-            flicker.add(&out.indirect, &reference.indirect, &reference.mask)?;
-            flicker_final.add(
-                &out.final_radiance,
-                &reference.final_radiance,
-                &reference.mask,
-            )?;
-            if k + 1 == plan.frames {
-                evals = light_patch_evals(&r, &settings, &out)?;
-            }
-            if k == plan.frames / 2 && c.is_default(&plan.base) {
-                let name = c.method.name();
-                crate::output::write_png(
-                    &images.join(format!("{name}.png")),
-                    out.width,
-                    out.height,
-                    &out.display,
-                )?;
-                crate::output::write_png(
-                    &images.join(format!("{name}-error.png")),
-                    out.width,
-                    out.height,
-                    &charts::heat_map(&map),
-                )?;
-            }
-            bar.inc(1);
-        }
-        if !measure {
-            continue;
-        }
-        let f = plan.frames as f64;
-        let mut row = timing_row(plan, spec, &settings, &stats);
-        row.key = plan.key(&spec.name, c.method.name(), &label);
-        row.label = label;
-        row.is_default = c.is_default(&plan.base);
-        row.rel_rmse_indirect = e_ind / f;
-        row.rel_rmse_final = e_fin / f;
-        row.truth.rel_rmse_indirect = e_truth.map(|e| e / f);
-        row.flip = e_flip / f;
-        row.flicker = flicker.flicker();
-        row.flicker_second = flicker.second_difference();
-        row.flicker_final = flicker_final.flicker();
-        row.flicker_pixel = flicker.per_pixel();
-        row.light_patch_evals = evals;
-        row.gpu_memory_bytes = memory;
-        if bar.is_hidden() {
-            // No terminal (a log, CI): one line per finished row instead.
-            eprintln!(
-                "{}: {} {}: {:.1} ms indirect, relative RMSE {:.4}",
-                row.scene,
-                row.method,
-                row.label,
-                row.indirect_ms.unwrap_or(f64::NAN),
-                row.rel_rmse_indirect
-            );
-        }
-        rows::append(journal, &row)?;
-    }
-    Ok(())
-}
-
-fn settings_of(plan: &Plan, method: Method) -> RenderSettings {
-    RenderSettings {
-        method,
-        ..plan.base.clone()
-    }
-}
-
-/// Light-patch evaluations of the last frame: counted by the multiresolution
-/// gathers (and splats), or pixels with geometry times what the method
-/// evaluates per pixel where that is fixed.
-fn light_patch_evals(r: &Renderer, s: &RenderSettings, out: &Readback) -> Result<Option<u64>> {
-    let d = crate::methods::find(s.method)?;
-    if d.uses_multires() {
-        return Ok(r
-            .readback_multires()?
-            .map(|m| crate::debug_view::light_patch_stats(&m, None).total_evaluations)
-            .filter(|&n| n > 0));
-    }
-    Ok(d.evaluations_per_pixel(s).map(|n| {
-        let pixels = out.position.iter().filter(|p| p[3] > 0.0).count() as u64;
-        pixels * n
-    }))
-}
-
-/// The values of every parameter `s`'s method reads, by name, as text.
-fn parameter_values(s: &RenderSettings) -> std::collections::BTreeMap<String, String> {
-    match crate::methods::find(s.method) {
-        Ok(d) => crate::methods::params_of(d)
-            .map(|p| (p.name().to_string(), p.text_in(s)))
-            .collect(),
-        Err(_) => Default::default(),
-    }
-}
-
-/// A row with the settings and the timings filled in; errors zero.
-fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameStats) -> Row {
-    let report = crate::report::build(
-        &crate::report::RunInfo {
-            device: "",
-            driver: "",
-            scene: &spec.name,
-            width: s.width,
-            height: s.height,
-            rsm: s.rsm_resolution,
-            method: s.method.name(),
-        },
-        stats,
-    );
-    let indirect_min = stats.gpu_ms_min(true);
-    let fragments = stats.counts().map(|f| {
-        f.iter()
-            .filter(|p| p.kind.indirect)
-            .filter_map(|p| p.fragment_invocations)
-            .sum::<u64>()
-    });
-    Row {
-        key: String::new(),
-        scene: spec.name.clone(),
-        method: s.method.name().into(),
-        label: String::new(),
-        is_default: false,
-        params: parameter_values(s),
-        width: s.width,
-        height: s.height,
-        rsm: s.rsm_resolution,
-        frames: plan.frames,
-        indirect_ms: report.indirect_gpu_ms_median,
-        indirect_ms_min: indirect_min,
-        total_ms: report.total_gpu_ms_median,
-        passes: report
-            .passes
-            .iter()
-            .filter_map(|p| Some((p.name.clone(), p.gpu_ms_median?)))
-            .collect(),
-        fragment_invocations: fragments,
-        light_patch_evals: None,
-        rel_rmse_indirect: 0.0,
-        rel_rmse_final: 0.0,
-        flip: 0.0,
-        flicker: None,
-        flicker_second: None,
-        flicker_final: None,
-        flicker_pixel: None,
-        gpu_memory_bytes: None,
-        truth: Default::default(),
-    }
 }

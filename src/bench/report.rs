@@ -11,6 +11,8 @@ use serde_json::json;
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Ratio {
     pub scene: String,
+    /// The visibility of the rows it is computed from (`Row::visibility`).
+    pub visibility: String,
     pub measure: String,
     pub value: Option<f64>,
     pub detail: String,
@@ -64,11 +66,36 @@ fn describe(r: &Row) -> String {
     )
 }
 
-/// The ratios of the issue, per scene: HISR's indirect-time speedup over each
-/// regular method with 256 VPLs at equal or lower error, over multires-gather
-/// with 4096 at its error, the error HISR reaches in the time of 256 regular
+/// The visibilities of `rows` (`Row::visibility`), in first appearance.
+pub fn visibilities(rows: &[Row]) -> Vec<&str> {
+    let mut out: Vec<&str> = vec![];
+    for r in rows {
+        if !out.contains(&r.visibility.as_str()) {
+            out.push(&r.visibility);
+        }
+    }
+    out
+}
+
+/// The rows of `rows` rendered with visibility `v`.
+fn with_visibility(rows: &[Row], v: &str) -> Vec<Row> {
+    rows.iter().filter(|r| r.visibility == v).cloned().collect()
+}
+
+/// The ratios of the issue, per scene and visibility (each from the rows of
+/// one visibility alone): HISR's indirect-time speedup over each regular
+/// method with 256 VPLs at equal or lower error, over multires-gather with
+/// 4096 at its error, the error HISR reaches in the time of 256 regular
 /// VPLs, and HISR's flicker against 256 and 4096 regular VPLs.
 pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
+    visibilities(rows)
+        .into_iter()
+        .flat_map(|v| ratios_of(&with_visibility(rows, v), v))
+        .collect()
+}
+
+/// [`ratios`] of rows of one visibility, `visibility`.
+fn ratios_of(rows: &[Row], visibility: &str) -> Vec<Ratio> {
     let mut scenes: Vec<&str> = vec![];
     for r in rows {
         if !scenes.contains(&r.scene.as_str()) {
@@ -80,6 +107,7 @@ pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
         let mut push = |measure: String, value: Option<f64>, detail: String| {
             out.push(Ratio {
                 scene: s.into(),
+                visibility: visibility.into(),
                 measure,
                 value,
                 detail,
@@ -184,14 +212,16 @@ fn flicker_64_over_4096(
 }
 
 /// `report.md`'s table of flicker with 64 over 4096 regular VPLs, per
-/// scene and method: low-passed, and per pixel in brackets.
+/// scene and method: low-passed, and per pixel in brackets; of the rows
+/// without visibility (what the measure was made to tell apart).
 fn flicker_table(plan: &Plan, o: &Outcome) -> String {
+    let rows = with_visibility(&o.rows, "none");
     let methods: Vec<&str> = regular()
         .into_iter()
         .filter(|m| {
             plan.scenes
                 .iter()
-                .any(|s| flicker_64_over_4096(&o.rows, &s.name, m).is_some())
+                .any(|s| flicker_64_over_4096(&rows, &s.name, m).is_some())
         })
         .collect();
     if methods.is_empty() {
@@ -211,7 +241,7 @@ before the low-pass, which the dense reference's own near-contact change dominat
     for s in &plan.scenes {
         md += &format!("| {} |", s.name);
         for m in &methods {
-            md += &match flicker_64_over_4096(&o.rows, &s.name, m) {
+            md += &match flicker_64_over_4096(&rows, &s.name, m) {
                 Some(((a, b), pixel)) => format!(
                     " {:.2} ({}) |",
                     a / b,
@@ -269,8 +299,9 @@ pub fn ratios_text(ratios: &[Ratio]) -> String {
     let mut out = String::new();
     for r in ratios {
         out += &format!(
-            "{:<14} {:<72} {:>8}  {}\n",
+            "{:<14} {:<10} {:<72} {:>8}  {}\n",
             r.scene,
+            r.visibility,
             r.measure,
             fmt_value(r.value),
             r.detail
@@ -291,7 +322,8 @@ pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio]) -> String {
 (1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
 section 6.2), errors means over frames against the dense reference of the same frame (section 6.1) \
 and against the path-traced truth (section 6.6), flicker over the sequence (section 6.3), FLIP on the \
-tone-mapped final image (section 6.4).{}\n\n",
+tone-mapped final image (section 6.4). Indirect visibility: {} (section 6.7; a row with it is held \
+against the dense reference with it, and the one truth of each frame).{}\n\n",
         o.device,
         o.driver,
         b.width,
@@ -299,6 +331,7 @@ tone-mapped final image (section 6.4).{}\n\n",
         b.rsm_resolution,
         plan.frames,
         plan.timing_frames,
+        visibilities(&o.rows).join(", "),
         if plan.quick { " Quick run (smoke test)." } else { "" }
     );
     md += "![speed against error](speed_vs_error.svg)\n\n\
@@ -306,12 +339,14 @@ tone-mapped final image (section 6.4).{}\n\n",
 ![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n";
     md += &model_errors(plan, o);
     md += &flicker_table(plan, o);
-    md += "\n## Ratios\n\n\
-| scene | measure | value | detail |\n| --- | --- | ---: | --- |\n";
+    md += &super::visibility::report_table(plan, &o.rows);
+    md += "\n## Ratios\n\nEach from the rows of one visibility.\n\n\
+| scene | visibility | measure | value | detail |\n| --- | --- | --- | ---: | --- |\n";
     for r in ratios {
         md += &format!(
-            "| {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} |\n",
             r.scene,
+            r.visibility,
             r.measure,
             fmt_value(r.value),
             r.detail
@@ -319,15 +354,16 @@ tone-mapped final image (section 6.4).{}\n\n",
     }
     for s in &plan.scenes {
         md += &format!(
-            "\n## {}\n\n| method | setting | indirect ms (min) | total ms | RMSE indirect | RMSE truth | RMSE final | FLIP | flicker | light-patch evals | memory MiB |\n\
-| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
+            "\n## {}\n\n| method | visibility | setting | indirect ms (min) | total ms | RMSE indirect | RMSE truth | RMSE final | FLIP | flicker | light-patch evals | memory MiB |\n\
+| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
             s.name
         );
         for r in o.rows.iter().filter(|r| r.scene == s.name) {
             md += &format!(
-                "| {}{} | {} | {} ({}) | {} | {:.4} | {} | {:.4} | {:.4} | {} | {} | {} |\n",
+                "| {}{} | {} | {} | {} ({}) | {} | {:.4} | {} | {:.4} | {:.4} | {} | {} | {} |\n",
                 r.method,
                 if r.is_default { " *" } else { "" },
+                r.visibility,
                 r.label,
                 cell(r.indirect_ms.map(|v| format!("{v:.1}"))),
                 cell(r.indirect_ms_min.map(|v| format!("{v:.1}"))),
@@ -345,7 +381,8 @@ tone-mapped final image (section 6.4).{}\n\n",
             );
         }
     }
-    md += "\n`*`: the method's default setting (gallery, per-pass chart).\n";
+    md += "\n`*`: the method's default setting (gallery, per-pass chart). RMSE indirect, RMSE final and \
+FLIP are against the dense reference with the row's visibility.\n";
     md
 }
 
@@ -363,20 +400,44 @@ from geometric and direct-shadow edges (docs/algorithm.md section 6.6): what eve
 visibility shares. A method can read below it where its own errors and the missing occlusion partly \
 cancel, so compare methods against the reference. With exact visibility (`--visibility exact`: one ray \
 per pixel and VPL, on the CPU, at the middle frame) the dense reference shows the floor of the VPL model \
-itself. The truth's noise adds to every error against it in quadrature.\n\n\
-| scene | model error | with exact visibility | truth spp | truth noise | pixels left out |\n\
-| --- | ---: | ---: | ---: | ---: | ---: |\n");
-    for s in &plan.scenes {
-        let Some(r) = o
-            .rows
+itself; with each further visibility of the run (`voxels N`: the grid, N cells a side), its own dense \
+reference. The truth's noise adds to every error against it in quadrature.\n\n");
+    // The visibilities of the references but `none`: a column each.
+    let reference = |s: &str, v: &str| {
+        o.rows
             .iter()
-            .find(|r| r.scene == s.name && r.method == "reference")
-        else {
+            .find(|r| r.scene == s && r.method == "reference" && r.visibility == v)
+    };
+    let others: Vec<&str> = visibilities(&o.rows)
+        .into_iter()
+        .filter(|&v| {
+            v != "none"
+                && o.rows
+                    .iter()
+                    .any(|r| r.method == "reference" && r.visibility == v)
+        })
+        .collect();
+    md += "| scene | model error |";
+    for v in &others {
+        md += &format!(" with {v} |");
+    }
+    md += " with exact visibility | truth spp | truth noise | pixels left out |\n| --- | ---: |";
+    md += &" ---: |".repeat(others.len() + 4);
+    md += "\n";
+    for s in &plan.scenes {
+        let Some(r) = reference(&s.name, "none") else {
             continue;
         };
         let t = &r.truth;
+        let with: String = others
+            .iter()
+            .map(|v| {
+                let e = reference(&s.name, v).and_then(|r| r.truth.rel_rmse_indirect);
+                format!(" {} |", cell(e.map(|v| format!("{v:.4}"))))
+            })
+            .collect();
         md += &format!(
-            "| {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} |{with} {} | {} | {} | {} |\n",
             s.name,
             cell(t.rel_rmse_indirect.map(|v| format!("{v:.4}"))),
             cell(t.floor.map(|v| format!("{v:.4}"))),
@@ -421,6 +482,7 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         "timing_frames": plan.timing_frames,
         "quick": plan.quick,
         "scenes": scenes,
+        "visibilities": visibilities(&o.rows),
         "ratios": ratios,
         "rows": o.rows,
     });
@@ -434,7 +496,12 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
     super::charts::flicker(dir, &o.rows, &scenes)?;
     super::charts::passes(dir, &o.rows, &scenes)?;
     let methods: Vec<&str> = plan.methods.iter().map(|m| m.name()).collect();
-    super::charts::gallery(dir, &o.rows, &scenes, &methods)?;
+    let passes: Vec<(String, &str)> = plan
+        .passes()
+        .iter()
+        .map(|p| (p.visibility_label(), p.image_suffix()))
+        .collect();
+    super::charts::gallery(dir, &o.rows, &scenes, &methods, &passes)?;
     crate::output::write_text(&dir.join("report.md"), &markdown(plan, o, &ratios))?;
     Ok(())
 }
@@ -454,6 +521,33 @@ mod tests {
         r.flicker = Some(flicker);
         r.is_default = method == "hisr" && ms == 10.0;
         r
+    }
+
+    #[test]
+    fn ratios_are_of_the_rows_of_one_visibility() {
+        let mut rows = vec![
+            row("multires-splat", Some(256), 100.0, 0.2, 0.04),
+            row("hisr", None, 10.0, 0.15, 0.01),
+        ];
+        // With the grid: a HISR point far faster at the same error, which
+        // the ratios without it must not see.
+        let mut fast = row("hisr", None, 1.0, 0.15, 0.01);
+        fast.visibility = "voxels 64".into();
+        let mut splat = row("multires-splat", Some(256), 200.0, 0.2, 0.04);
+        splat.visibility = "voxels 64".into();
+        rows.extend([fast, splat]);
+        let r = ratios(&rows);
+        let get = |v: &str| {
+            r.iter()
+                .find(|x| {
+                    x.visibility == v
+                        && x.measure.starts_with("speedup of hisr over multires-splat")
+                })
+                .unwrap()
+                .value
+        };
+        assert_eq!(get("none"), Some(10.0));
+        assert_eq!(get("voxels 64"), Some(200.0));
     }
 
     #[test]

@@ -14,6 +14,11 @@ pub struct Row {
     pub key: String,
     pub scene: String,
     pub method: String,
+    /// The indirect visibility it rendered with (`bench::visibility`):
+    /// `none`, or `voxels N` (the grid's side). Empty in rows journalled
+    /// before the axis; the run fills it in from the row's key.
+    #[serde(default)]
+    pub visibility: String,
     pub label: String,
     pub is_default: bool,
     /// The value of every parameter the method reads, by option name
@@ -180,11 +185,17 @@ impl Row {
     }
 }
 
-/// The parameter names of all rows, in order of first appearance.
+/// The parameter names of all rows, in order of first appearance, but the
+/// visibility's: a row's `visibility` column says it (`voxels 64`), in every
+/// row, where theirs would be empty for the methods that read none.
 pub fn param_names(rows: &[Row]) -> Vec<String> {
+    use crate::passes::visibility_grid::{GRID, VISIBILITY};
     let mut names: Vec<String> = vec![];
     for r in rows {
         for n in r.params.keys() {
+            if n == VISIBILITY.name || n == GRID.name {
+                continue;
+            }
             if !names.contains(n) {
                 names.push(n.clone());
             }
@@ -211,7 +222,7 @@ pub fn pass_names(rows: &[Row]) -> Vec<String> {
 pub fn to_csv(rows: &[Row]) -> String {
     let params = param_names(rows);
     let passes = pass_names(rows);
-    let mut out = String::from("scene,method,label,is_default");
+    let mut out = String::from("scene,method,visibility,label,is_default");
     for p in &params {
         out += &format!(",{p}");
     }
@@ -226,6 +237,7 @@ flicker_pixel,gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_o
         let mut cells = vec![
             r.scene.clone(),
             r.method.clone(),
+            r.visibility.clone(),
             format!("\"{}\"", r.label),
             r.is_default.to_string(),
         ];
@@ -277,9 +289,10 @@ pub(crate) mod tests_support {
             key: key.into(),
             scene: "s".into(),
             method: "hisr".into(),
+            visibility: "none".into(),
             label: "tau 0.05, depth 6".into(),
             is_default: true,
-            params: [("tau", "0.05"), ("max-depth", "6")]
+            params: [("tau", "0.05"), ("max-depth", "6"), ("visibility", "none")]
                 .iter()
                 .map(|(k, v)| (k.to_string(), v.to_string()))
                 .collect(),
@@ -362,8 +375,11 @@ mod tests {
         let csv = to_csv(&[row("a")]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(",gather_ms"));
-        assert!(lines[0].starts_with("scene,method,label,is_default,max-depth,tau,width,"));
-        assert!(lines[1].contains(",hisr,\"tau 0.05, depth 6\",true,6,0.05,8,"));
+        // The visibility is its own column, not a parameter's.
+        assert!(
+            lines[0].starts_with("scene,method,visibility,label,is_default,max-depth,tau,width,")
+        );
+        assert!(lines[1].contains(",hisr,none,\"tau 0.05, depth 6\",true,6,0.05,8,"));
         assert!(lines[1].ends_with(",1"));
     }
 }

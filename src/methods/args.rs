@@ -33,42 +33,76 @@ fn help_text(p: &dyn AnyParam) -> String {
     )
 }
 
-impl clap::FromArgMatches for ParamArgs {
-    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
-        let mut args = Self::default();
-        args.update_from_arg_matches(m)?;
-        Ok(args)
-    }
+/// [`ParamArgs`] but for `--visibility`: `isr bench` takes a list there
+/// (its visibility axis, `bench::visibility`), where the parameter is one value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ParamArgsButVisibility(pub Params);
 
-    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
-        for p in all_params() {
-            if let Some(v) = m.get_one::<Value>(p.name()) {
-                self.0.insert(p.name(), *v);
+/// Both kinds are clap arguments, one option per parameter but those named.
+macro_rules! param_args {
+    ($t:ty, $except:expr) => {
+        impl clap::FromArgMatches for $t {
+            fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+                let mut args = Self::default();
+                args.update_from_arg_matches(m)?;
+                Ok(args)
+            }
+
+            fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+                self.0 .0.extend(read(m, $except).0);
+                Ok(())
             }
         }
-        Ok(())
-    }
+
+        impl clap::Args for $t {
+            fn augment_args(cmd: clap::Command) -> clap::Command {
+                augment(cmd, $except)
+            }
+
+            fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+                augment(cmd, $except)
+            }
+        }
+    };
 }
 
-impl clap::Args for ParamArgs {
-    fn augment_args(mut cmd: clap::Command) -> clap::Command {
-        for p in all_params() {
-            cmd = cmd.arg(
-                clap::Arg::new(p.name())
-                    .long(p.name())
-                    .value_name(p.value_name())
-                    .help(help_text(p))
-                    .help_heading("Method parameters")
-                    .allow_negative_numbers(true)
-                    .value_parser(move |text: &str| p.parse(text)),
-            );
-        }
-        cmd
-    }
+param_args!(ParamArgs, &[]);
+param_args!(
+    ParamArgsButVisibility,
+    &[crate::passes::visibility_grid::VISIBILITY.name]
+);
 
-    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
-        Self::augment_args(cmd)
+/// The values given in `m` of every parameter but those in `except`.
+fn read(m: &clap::ArgMatches, except: &[&str]) -> Params {
+    let mut params = Params::default();
+    for p in all_params() {
+        if except.contains(&p.name()) {
+            continue;
+        }
+        if let Some(v) = m.get_one::<Value>(p.name()) {
+            params.insert(p.name(), *v);
+        }
     }
+    params
+}
+
+/// `cmd` with an option per parameter but those in `except`.
+fn augment(mut cmd: clap::Command, except: &[&str]) -> clap::Command {
+    for p in all_params() {
+        if except.contains(&p.name()) {
+            continue;
+        }
+        cmd = cmd.arg(
+            clap::Arg::new(p.name())
+                .long(p.name())
+                .value_name(p.value_name())
+                .help(help_text(p))
+                .help_heading("Method parameters")
+                .allow_negative_numbers(true)
+                .value_parser(move |text: &str| p.parse(text)),
+        );
+    }
+    cmd
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@ use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
 use anyhow::{anyhow, bail, Result};
-pub use args::ParamArgs;
+pub use args::{ParamArgs, ParamArgsButVisibility};
 
 /// Every method, in the order of the CLI's help, the viewer's `M` key and
 /// the bench's reports: the baselines, then the paper's methods, then the
