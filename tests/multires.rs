@@ -438,6 +438,7 @@ fn point_sampled_vpls_scale_flux_by_the_patch_size() {
                     dvec(&nrm[t]),
                     dvec(&flux[t]) * scale,
                     pos[t][3] as f64 * scale,
+                    patch_level(k, nrm[t][3]),
                 )
             })
         })

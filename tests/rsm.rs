@@ -214,8 +214,9 @@ struct Node {
 }
 
 /// docs/algorithm.md section 2 ("A patch P"), computed independently of the
-/// GPU from the RSM itself: flux, solid angle and area add up, position and
-/// normal are area-weighted means, and a patch is valid when its non-empty
+/// GPU from the RSM itself: flux, solid angle and area add up, position is
+/// the mean weighted by the flux's luminance (by area where the patch has
+/// no flux), normal the area-weighted mean, and a patch is valid when its non-empty
 /// children are valid and lie on one surface (offset from the patch's plane
 /// under `depth` times the child's distance to the light, normal within
 /// `cos_normal`).
@@ -235,7 +236,14 @@ fn cpu_level(
                 .collect();
             let area: f64 = c.iter().map(|n| n.area).sum();
             let flux = c.iter().map(|n| n.flux).sum();
-            let position = if area > 0.0 {
+            let luminance = |n: &Node| 0.2126 * n.flux.x + 0.7152 * n.flux.y + 0.0722 * n.flux.z;
+            let lit: f64 = c.iter().map(luminance).sum();
+            let position = if lit > 0.0 {
+                c.iter()
+                    .map(|n| n.position * luminance(n))
+                    .sum::<glam::DVec3>()
+                    / lit
+            } else if area > 0.0 {
                 c.iter().map(|n| n.position * n.area).sum::<glam::DVec3>() / area
             } else {
                 glam::DVec3::ZERO

@@ -467,28 +467,51 @@ pub fn dvec(a: &[f32; 4]) -> DVec3 {
     DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
 }
 
-/// The regular VPLs of RSM quadtree level `k` as (position, normal, flux, area).
-pub fn vpls_at(m: &isr::readback::MultiresReadback, k: usize) -> Vec<(DVec3, DVec3, DVec3, f64)> {
+/// A light patch for [`cpu_gather`]: position, unit normal, flux, area and
+/// its level as `patch_level` (shaders/shared.glsl) gives it.
+pub type CpuVpl = (DVec3, DVec3, DVec3, f64, i32);
+
+/// `patch_level` of shaders/shared.glsl: level `k`, negated when the
+/// patch's state (normal.w) says it spans a discontinuity.
+pub fn patch_level(k: usize, state: f32) -> i32 {
+    if state == isr::gpu_types::PATCH_INVALID {
+        -(k as i32)
+    } else {
+        k as i32
+    }
+}
+
+/// The regular VPLs of RSM quadtree level `k`.
+pub fn vpls_at(m: &isr::readback::MultiresReadback, k: usize) -> Vec<CpuVpl> {
     let [pos, nrm, flux] = &m.rsm_tree[k];
     pos.iter()
         .zip(nrm)
         .zip(flux)
         .filter(|((p, _), _)| p[3] > 0.0)
-        .map(|((p, n), f)| (dvec(p), dvec(n), dvec(f), p[3] as f64))
+        .map(|((p, n), f)| (dvec(p), dvec(n), dvec(f), p[3] as f64, patch_level(k, n[3])))
         .collect()
 }
 
-/// docs/algorithm.md section 2 in f64: sum over patches of
-/// Phi_j cos_i cos_j / (pi d^2 + A_j), the irradiance at (x, n).
-pub fn cpu_gather(vpls: &[(DVec3, DVec3, DVec3, f64)], x: DVec3, n: DVec3) -> DVec3 {
+/// docs/algorithm.md section 2.6 in f64, with the default second-order
+/// kernel for merged patches on one surface (level > 0): the irradiance
+/// at (x, n) from `vpls`.
+pub fn cpu_gather(vpls: &[CpuVpl], x: DVec3, n: DVec3) -> DVec3 {
     let mut e = DVec3::ZERO;
-    for &(xj, nj, phi, a) in vpls {
+    for &(xj, nj, phi, a, level) in vpls {
         let v = xj - x;
         let d2 = v.length_squared();
         let dir = v / d2.sqrt().max(1e-15);
         let cos_i = n.dot(dir).max(0.0);
         let cos_j = (-nj.dot(dir)).max(0.0);
-        e += phi * (cos_i * cos_j / (std::f64::consts::PI * d2 + a));
+        let denominator = std::f64::consts::PI * d2 + a;
+        let mut k = cos_i * cos_j / denominator;
+        if level > 0 && k > 0.0 {
+            let f = a / denominator;
+            let second = cos_i * cos_j * (1.0 + f * (2.0 - 3.0 * cos_j * cos_j))
+                - f * cos_j * cos_j * n.dot(nj);
+            k = (second / denominator).clamp(0.0, 1.0 / denominator);
+        }
+        e += phi * k;
     }
     e
 }
