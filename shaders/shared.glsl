@@ -114,7 +114,7 @@ const float PI = 3.14159265358979323846;
 
 // One light patch chosen by Basic ISR (a node of the RSM quadtree).
 struct LightPatch {
-    vec4 position_area;  // xyz: area-weighted mean position (m); w: area A (m^2)
+    vec4 position_area;  // xyz: flux-weighted mean position (m; rsm_tree.comp); w: area A (m^2)
     vec4 normal;         // xyz: unit mean normal; w: patch_level (the lists: ISR's and
                          // the regular VPLs') or PATCH_* (HISR's packed tree)
     vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr), or
