@@ -248,3 +248,27 @@ fn every_numeric_option_takes_values_with_a_minus_sign() {
     let e = Isr::tiny(&dir).args(["--exposure", "-inf"]).fails();
     assert!(e.contains("--exposure") && e.contains("finite"), "{e}");
 }
+
+/// `--visibility-grid` without `--visibility voxels` is most likely a
+/// forgotten `--visibility voxels`: the render runs and says the grid has
+/// no effect; with the grid on, nothing is said.
+#[test]
+fn a_grid_without_voxel_visibility_is_named_as_having_no_effect() {
+    let dir = temp_dir("grid-without-voxels");
+    let warning = "--visibility-grid 32 has no effect without --visibility voxels";
+    let ran = Isr::tiny(&dir)
+        .args(["--method", "hisr", "--visibility-grid", "32"])
+        .succeeds();
+    assert!(ran.stderr.contains(warning), "{}", ran.stderr);
+    let ran = Isr::tiny(&dir)
+        .args([
+            "--method",
+            "hisr",
+            "--visibility",
+            "voxels",
+            "--visibility-grid",
+            "32",
+        ])
+        .succeeds();
+    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+}

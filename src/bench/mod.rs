@@ -257,6 +257,10 @@ impl BenchArgs {
             params: self.params.0.clone(),
             ..RenderSettings::DEFAULT
         };
+        let grid_used = visibilities.contains(&Visibility::Voxels);
+        if let Some(w) = crate::passes::visibility_grid::unused_grid_warning(&base, grid_used) {
+            eprintln!("{w}");
+        }
         // Each pass sets its own (`Plan::passes`); a grid out of range is
         // refused before any work.
         let base = visibility::with(&base, Visibility::None);

@@ -322,7 +322,12 @@ fn render(args: RenderArgs) -> Result<()> {
     // The settings' own checks need no device: they fail before it starts.
     crate::frame::check::check_ranges(&settings)?;
     crate::methods::check(&settings)?;
-    use crate::passes::visibility_grid::{Visibility, VISIBILITY};
+    use crate::passes::visibility_grid::{
+        unused_grid_warning, uses_voxels, Visibility, VISIBILITY,
+    };
+    if let Some(w) = unused_grid_warning(&settings, uses_voxels(&settings)) {
+        eprintln!("{w}");
+    }
     let exact =
         descriptor.takes_exact_visibility() && VISIBILITY.get(&settings) == Visibility::Exact;
     if exact && args.sequence.is_some() {

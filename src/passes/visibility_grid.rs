@@ -99,6 +99,18 @@ pub fn uses_voxels(s: &RenderSettings) -> bool {
     VISIBILITY.get(s) == Visibility::Voxels
 }
 
+/// The warning for `--visibility-grid` set where no run uses the grid
+/// (`grid_used`: whether one does), which is most likely a forgotten
+/// `--visibility voxels`.
+pub fn unused_grid_warning(s: &RenderSettings, grid_used: bool) -> Option<String> {
+    (GRID.is_set_in(s) && !grid_used).then(|| {
+        format!(
+            "warning: --visibility-grid {} has no effect without --visibility voxels",
+            GRID.get(s)
+        )
+    })
+}
+
 /// The specialization constant `VOXEL_VISIBILITY` (`shaders/vpl.glsl`) of
 /// every pipeline that evaluates the patch formula: the march is compiled
 /// only into runs with the grid (a uniform branch around it slowed every
