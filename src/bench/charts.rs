@@ -314,15 +314,20 @@ fn series_in(rows: &[Row]) -> Vec<Series<'_>> {
     out
 }
 
+/// Where a legend cell of `size` pixels puts its `n` rows: the left of its
+/// marks, the first row's y and the step between rows (the rows centred).
+fn legend_rows((w, h): (u32, u32), n: usize) -> (i32, i32, i32) {
+    let step = (h as i32 / (n as i32 + 1)).clamp(12, 22);
+    (w as i32 / 6, (h as i32 - step * n as i32) / 2, step)
+}
+
 /// The legend of `series`, drawn alone in a free cell of the grid: a
 /// series with visibility dashed with a hollow dot, as its curve.
 fn legend_panel<DB: DrawingBackend>(cell: &DrawingArea<DB, Shift>, series: &[Series]) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let (w, h) = cell.dim_in_pixel();
-    let step = (h as i32 / (series.len() as i32 + 1)).clamp(12, 22);
-    let (x0, y0) = (w as i32 / 6, (h as i32 - step * series.len() as i32) / 2);
+    let (x0, y0, step) = legend_rows(cell.dim_in_pixel(), series.len());
     for (i, s) in series.iter().enumerate() {
         let y = y0 + step * i as i32;
         let style = method_color(s.method).stroke_width(3);
@@ -512,9 +517,7 @@ fn pass_legend<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let (w, h) = cell.dim_in_pixel();
-    let step = (h as i32 / (passes.len() as i32 + 1)).clamp(12, 22);
-    let (x0, y0) = (w as i32 / 6, (h as i32 - step * passes.len() as i32) / 2);
+    let (x0, y0, step) = legend_rows(cell.dim_in_pixel(), passes.len());
     for (i, pass) in passes.iter().enumerate() {
         let y = y0 + step * i as i32;
         cell.draw(&Rectangle::new(
