@@ -3,6 +3,7 @@
 //! computed from the same rows.
 
 use super::rows::{self, Row};
+use super::visibility::visibilities;
 use super::{Outcome, Plan};
 use anyhow::Result;
 use serde_json::json;
@@ -64,17 +65,6 @@ fn describe(r: &Row) -> String {
         ms(r),
         r.rel_rmse_indirect
     )
-}
-
-/// The visibilities of `rows` (`Row::visibility`), in first appearance.
-pub fn visibilities(rows: &[Row]) -> Vec<&str> {
-    let mut out: Vec<&str> = vec![];
-    for r in rows {
-        if !out.contains(&r.visibility.as_str()) {
-            out.push(&r.visibility);
-        }
-    }
-    out
 }
 
 /// The rows of `rows` rendered with visibility `v`.

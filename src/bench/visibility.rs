@@ -66,6 +66,17 @@ pub fn with(s: &RenderSettings, v: Visibility) -> RenderSettings {
     s
 }
 
+/// The visibilities of `rows` (`Row::visibility`), in first appearance.
+pub fn visibilities(rows: &[Row]) -> Vec<&str> {
+    let mut out: Vec<&str> = vec![];
+    for r in rows {
+        if !out.contains(&r.visibility.as_str()) {
+            out.push(&r.visibility);
+        }
+    }
+    out
+}
+
 /// Whether `method` renders differently with indirect visibility.
 pub fn reads(method: Method) -> bool {
     crate::methods::find(method).is_ok_and(|d| d.reads_visibility())
@@ -150,7 +161,7 @@ impl Plan {
 /// ratio, flicker. Empty when the rows have one visibility.
 pub fn report_table(plan: &Plan, rows: &[Row]) -> String {
     let mut md = String::new();
-    for other in super::report::visibilities(rows) {
+    for other in visibilities(rows) {
         if matches!(other, "" | "none") {
             continue;
         }
