@@ -23,7 +23,7 @@ fn main() -> anyhow::Result<()> {
     println!("{} on {}", outcome.device, outcome.driver);
     print!(
         "{}",
-        bench::report::ratios_text(&bench::report::ratios(&outcome.rows))
+        bench::ratios::ratios_text(&bench::ratios::ratios(&outcome.rows))
     );
     println!("report: {}", plan.out_dir.join("report.md").display());
     Ok(())

@@ -6,7 +6,7 @@
 
 use super::rows::{self, Row};
 use super::sweep::Config;
-use super::{charts, flip, frame_time, metrics, truth_cache, Plan, SceneSpec};
+use super::{flip, frame_time, gallery, metrics, truth_cache, Plan, SceneSpec};
 use super::{visibility, REFERENCE, REFERENCE_LABEL};
 use crate::passes::visibility_grid::Visibility;
 use crate::readback::Readback;
@@ -318,7 +318,7 @@ fn points(
                     &images.join(error),
                     out.width,
                     out.height,
-                    &charts::heat_map(&map),
+                    &gallery::heat_map(&map),
                 )?;
             }
             bar.inc(1);

@@ -6,8 +6,10 @@
 
 pub mod charts;
 pub mod flip;
+pub mod gallery;
 mod measure;
 pub mod metrics;
+pub mod ratios;
 pub mod report;
 pub mod rows;
 pub mod scenes;
@@ -487,7 +489,7 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
 pub fn cli(args: &BenchArgs) -> Result<()> {
     let plan = args.plan()?;
     let outcome = run(&plan)?;
-    println!("{}", report::ratios_text(&report::ratios(&outcome.rows)));
+    println!("{}", ratios::ratios_text(&ratios::ratios(&outcome.rows)));
     println!(
         "wrote results.json, results.csv, charts, gallery.png and report.md to {}",
         plan.out_dir.display()
