@@ -9,7 +9,7 @@
 int regular_vpl_count() { return run.vpl_side * run.vpl_side; }
 
 // VPL j in row-major order; false when its patch saw nothing lit. nrm.w:
-// its level as the lists keep it (patch_level in vpl.glsl).
+// its level as the lists keep it (patch_level in shared.glsl).
 bool regular_vpl(int j, out vec4 pos, out vec4 nrm, out vec3 flux) {
     int k = run.vpl_level;
     int side = run.vpl_side;

@@ -131,7 +131,6 @@ const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR 
 // (state PATCH_INVALID), whose texels lie on no one disc.
 int patch_level(int k, float state) { return state == PATCH_INVALID ? -k : k; }
 
-
 // HISR splits an invalid patch while its bound could exceed tau times this
 // (gather.frag, docs/algorithm.md section 4.3).
 const float HISR_INVALID_TAU_SCALE = 0.01;

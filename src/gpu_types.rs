@@ -147,8 +147,10 @@ impl InstanceTransform {
 pub struct LightPatch {
     /// xyz: mean position; w: area.
     pub position_area: [f32; 4],
-    /// xyz: mean normal; w: quadtree level (RSM mip), negated where the
-    /// patch spans a discontinuity (`patch_level` in `shaders/shared.glsl`).
+    /// xyz: mean normal; w: in the lists (ISR's, the regular VPLs') the
+    /// quadtree level (RSM mip), negated where the patch spans a
+    /// discontinuity (`patch_level` in `shaders/shared.glsl`); in HISR's
+    /// packed tree `PATCH_*`.
     pub normal: [f32; 4],
     /// rgb: flux; a: solid angle (in HISR's packed tree: the squared reach).
     pub flux: [f32; 4],
