@@ -405,6 +405,36 @@ pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     )
 }
 
+/// The passes' colours: Kelly's colours of maximum contrast (less white),
+/// and three more, one for each pass a full bench draws, so that neighbouring passes in a bar stay apart (with `Palette99`,
+/// `visibility-grid` and `composite` came out alike).
+const PASS_COLOURS: [(u8, u8, u8); 24] = [
+    (0xF3, 0xC3, 0x00),
+    (0x87, 0x56, 0x92),
+    (0xF3, 0x84, 0x00),
+    (0xA1, 0xCA, 0xF1),
+    (0xBE, 0x00, 0x32),
+    (0xC2, 0xB2, 0x80),
+    (0x84, 0x84, 0x82),
+    (0x00, 0x88, 0x56),
+    (0xE6, 0x8F, 0xAC),
+    (0x00, 0x67, 0xA5),
+    (0xF9, 0x93, 0x79),
+    (0x60, 0x4E, 0x97),
+    (0xF6, 0xA6, 0x00),
+    (0xB3, 0x44, 0x6C),
+    (0xDC, 0xD3, 0x00),
+    (0x88, 0x2D, 0x17),
+    (0x8D, 0xB6, 0x00),
+    (0x65, 0x45, 0x22),
+    (0xE2, 0x58, 0x22),
+    (0x2B, 0x3D, 0x26),
+    (0x22, 0x22, 0x22),
+    (0x00, 0xA6, 0xA6),
+    (0xFF, 0x4F, 0xFF),
+    (0x7F, 0xFF, 0xD4),
+];
+
 /// Stacked per-pass times of each method at its default, one panel per scene.
 fn stacked<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -428,7 +458,10 @@ where
         .into_iter()
         .filter(|p| rows.iter().filter(is_bar).any(|r| r.passes.contains_key(p)))
         .collect();
-    let palette = |i: usize| Palette99::pick(i).to_rgba();
+    let palette = |i: usize| {
+        let (r, g, b) = PASS_COLOURS[i % PASS_COLOURS.len()];
+        RGBAColor(r, g, b, 1.0)
+    };
     if let Some(cell) = panels.get(scenes.len()) {
         pass_legend(cell, &passes, &palette)?;
     }
@@ -470,6 +503,9 @@ where
                 }
             })
             .x_desc("ms")
+            // Few, short labels: a panel is narrow.
+            .x_labels(5)
+            .x_label_formatter(&|v| short(*v))
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
