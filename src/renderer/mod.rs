@@ -1,7 +1,8 @@
 //! The renderer: creates a run's passes and method, records every frame,
 //! submits it with up to two frames in flight, and destroys it all. What the
 //! passes share (settings, targets, scene, uniforms) lives below it in
-//! `frame`; reading results back lives in `readback`.
+//! `frame`; reading results back lives in `readback` (the renderer's accessors
+//! in `results`).
 //!
 //! Frames are recorded anew every frame: recording is cheap (tens of
 //! commands), and it keeps the frame free to change shape (a method switch,
@@ -12,28 +13,31 @@
 use crate::frame::check::{check_light_views, check_ranges, check_settings, AddedMemory};
 use crate::frame::uniforms::{frame_uniforms, instance_transforms};
 use crate::frame::{FrameContext, FrameSet, Samplers, SceneGpu, Setup, Targets};
-use crate::gpu_types::{FrameUniforms, LightPatch, RunUniforms};
+use crate::gpu_types::{FrameUniforms, RunUniforms};
 use crate::methods::{Descriptor, IndirectMethod};
-use crate::multires::MultiresBuffer;
 use crate::passes::light_sum::{LightSumPass, SumStep};
 use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::{self, RsmTreePass};
 use crate::passes::visibility_grid::{self, VisibilityGridPass};
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
-use crate::readback::{self, MultiresReadback, Readback};
 use crate::scene::{FrameState, LightKind, Scene};
 use crate::settings::RenderSettings;
-use crate::view::{light_views, LightView};
+use crate::view::LightView;
 use crate::vk::profiler::{PassSample, Profiler};
 
 mod interactive;
+mod results;
+mod slot;
 mod stats;
+mod views;
 use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
 pub use interactive::FrameExtension;
+use slot::Slot;
 pub use stats::{median, FrameStats};
 use std::time::Instant;
+use views::{all_views, mesh_bounds, relative, ViewFitting};
 
 pub use crate::frame::FRAMES_IN_FLIGHT;
 
@@ -50,69 +54,6 @@ pub struct FrameProgress {
     /// Submissions of the frame in progress finished, of `submissions`.
     pub submission: u32,
     pub submissions: u32,
-}
-
-/// One frame in flight: its frame sets (one per light view), command
-/// buffers, queries and fence.
-struct Slot<'g> {
-    gpu: &'g Gpu,
-    frames: Vec<FrameSet>,
-    profiler: Profiler,
-    cmds: Vec<vk::CommandBuffer>,
-    fence: vk::Fence,
-    /// The frame this slot holds while it is in flight, and when it was submitted.
-    in_flight: Option<(u32, Instant)>,
-}
-
-impl<'g> Slot<'g> {
-    fn new(
-        gpu: &'g Gpu,
-        (run, grid): (&Buffer, &Buffer),
-        instances: usize,
-        views: usize,
-        passes: u32,
-    ) -> Result<Self> {
-        let frames = (0..views)
-            .map(|_| FrameSet::new(gpu, run, grid, instances))
-            .collect::<Result<Vec<_>>>()?;
-        let profiler = Profiler::new(gpu, passes)?;
-        let fence = unsafe {
-            gpu.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        }?;
-        Ok(Self {
-            gpu,
-            frames,
-            profiler,
-            cmds: Vec::new(),
-            fence,
-            in_flight: None,
-        })
-    }
-
-    /// `n` command buffers, allocated on first use and reused after.
-    fn command_buffers(&mut self, n: usize) -> Result<&[vk::CommandBuffer]> {
-        while self.cmds.len() < n {
-            let cmd = self.gpu.allocate_command_buffer()?;
-            self.cmds.push(cmd);
-        }
-        Ok(&self.cmds[..n])
-    }
-}
-
-impl Drop for Slot<'_> {
-    fn drop(&mut self) {
-        let d = &self.gpu.device;
-        unsafe {
-            if self.in_flight.is_some() {
-                let _ = d.wait_for_fences(&[self.fence], true, u64::MAX);
-            }
-            if !self.cmds.is_empty() {
-                d.free_command_buffers(self.gpu.command_pool, &self.cmds);
-            }
-            d.destroy_fence(self.fence, None);
-        }
-    }
 }
 
 pub struct Renderer<'g> {
@@ -601,71 +542,6 @@ impl<'g> Renderer<'g> {
         }
         Ok(stats)
     }
-
-    /// Copies every output of the last frame back to the host, positions
-    /// in world space.
-    pub fn readback(&self) -> Result<Readback> {
-        let mut r = readback::read_frame(self.gpu, &self.targets)?;
-        readback::to_world(&mut r.position, self.origin);
-        readback::to_world(&mut r.rsm.position, self.origin);
-        Ok(r)
-    }
-
-    /// What the GPU renders relative to (`scene::render_origin`).
-    pub fn render_origin(&self) -> glam::DVec3 {
-        self.origin
-    }
-
-    /// The multiresolution buffer of the last frame, if the method has one,
-    /// positions in world space.
-    pub fn readback_multires(&self) -> Result<Option<MultiresReadback>> {
-        let Some(m) = self.method.multires() else {
-            return Ok(None);
-        };
-        let mut r = readback::read_multires(self.gpu, m, &self.targets)?;
-        for level in &mut r.geo_mean {
-            readback::to_world(level, self.origin);
-        }
-        for level in &mut r.rsm_tree {
-            readback::to_world(&mut level[0], self.origin);
-        }
-        Ok(Some(r))
-    }
-
-    /// The multiresolution buffer, if the method has one.
-    pub fn multires(&self) -> Option<&MultiresBuffer> {
-        self.method.multires()
-    }
-
-    /// The light patches Basic ISR chose in the last frame (`None` for other
-    /// methods), positions in world space.
-    pub fn isr_chosen(&self) -> Result<Option<Vec<LightPatch>>> {
-        self.patches(self.method.chosen_patches())
-    }
-
-    /// HISR's packed light tree, root first (`shaders/light_tree_pack.comp`),
-    /// positions in world space.
-    pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
-        self.patches(self.method.packed_light_tree())
-    }
-
-    fn patches(&self, buffer: Option<&Buffer>) -> Result<Option<Vec<LightPatch>>> {
-        let Some(b) = buffer else {
-            return Ok(None);
-        };
-        let mut patches = readback::read_chosen_patches(self.gpu, b)?;
-        let mut positions: Vec<[f32; 4]> = patches.iter().map(|p| p.position_area).collect();
-        readback::to_world(&mut positions, self.origin);
-        for (p, q) in patches.iter_mut().zip(positions) {
-            p.position_area = q;
-        }
-        Ok(Some(patches))
-    }
-
-    /// How many light patches Basic ISR chose in the last frame.
-    pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
-        Ok(self.isr_chosen()?.map(|c| c.len() as u32))
-    }
 }
 
 /// Checks `settings` for a run with `lights` (`views` RSMs, `instances`
@@ -709,63 +585,6 @@ fn run_uniforms(d: &dyn Descriptor, s: &RenderSettings) -> RunUniforms {
     rsm_tree::write_uniforms(s, &mut u);
     crate::methods::write_uniforms(d, s, &mut u);
     u
-}
-
-/// `bounds` relative to `origin`, widened by a rounding so that they still
-/// hold every relative position.
-fn relative(bounds: (glam::Vec3, glam::Vec3), origin: glam::DVec3) -> (glam::Vec3, glam::Vec3) {
-    let (lo, hi) = (bounds.0.as_dvec3() - origin, bounds.1.as_dvec3() - origin);
-    let pad = (hi - lo).length() * 1e-6;
-    ((lo - pad).as_vec3(), (hi + pad).as_vec3())
-}
-
-/// What the light views are fitted to: the scene's world bounds, the
-/// render origin, each instance's object-space bounds, the image size.
-struct ViewFitting<'a> {
-    bounds: (glam::Vec3, glam::Vec3),
-    origin: glam::DVec3,
-    objects: &'a [(glam::Vec3, glam::Vec3)],
-    size: (u32, u32),
-}
-
-/// Every light view of `state`'s lights (`state` relative to the render
-/// origin), in light order, relative to the origin; directional lights'
-/// RSMs fitted to the view where the scene holds much more
-/// (`view::fit_directional`).
-fn all_views(state: &FrameState, f: &ViewFitting, rsm: u32) -> Vec<LightView> {
-    let bounds = relative(f.bounds, f.origin);
-    let directional = state
-        .lights
-        .iter()
-        .any(|l| l.kind == LightKind::Directional);
-    let boxes: Vec<(glam::Vec3, glam::Vec3)> = match directional {
-        true => f
-            .objects
-            .iter()
-            .zip(&state.instance_transforms)
-            .map(|(b, m)| crate::view::transformed_box(m, *b))
-            .collect(),
-        false => vec![],
-    };
-    let camera = crate::view::camera_view_proj(&state.camera, f.size.0, f.size.1);
-    state
-        .lights
-        .iter()
-        .enumerate()
-        .flat_map(|(i, l)| {
-            let fit = (l.kind == LightKind::Directional)
-                .then(|| crate::view::fit_directional(l.direction, &boxes, camera, bounds))
-                .flatten();
-            light_views(i, l, bounds, fit.as_ref(), rsm)
-        })
-        .collect()
-}
-
-/// A mesh's bounds in its own space (a point at the origin for no vertices).
-fn mesh_bounds(mesh: &crate::scene::Mesh) -> (glam::Vec3, glam::Vec3) {
-    let mut it = mesh.vertices.iter().map(|v| glam::Vec3::from(v.position));
-    let first = it.next().unwrap_or(glam::Vec3::ZERO);
-    it.fold((first, first), |(a, b), p| (a.min(p), b.max(p)))
 }
 
 impl Drop for Renderer<'_> {
