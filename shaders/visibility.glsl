@@ -39,16 +39,28 @@ const float VISIBILITY_END_SKIP = 1.75;
 // each march is at most VISIBILITY_MAX_ITERATIONS iterations of
 // six cells entered or levels changed each (docs/algorithm.md section 5,
 // "Voxel visibility", has the bound per method). A march that has not ended
-// by then counts as visible.
+// by then counts what it has found so far.
 const int VISIBILITY_MAX_ITERATIONS = 13;
 
-// 1 if the segment xi -> xj crosses no occupied finest cell outside the two
-// ends' skipped parts, else 0. ni, nj: unit normals of the receiver and the
-// patch (the rise over each one's plane is where the contribution is not 0).
-// A hierarchical DDA: at each point, the coarsest level whose cell there is
-// empty is skipped whole (found from level 1 up); an occupied cell is entered one level finer; an
-// occupied finest cell blocks; after leaving a cell the march climbs a level
-// only where it also left the parent cell.
+// What blocks: the segment's length inside occupied finest cells, in cells.
+// Visibility is 1 - that length / VISIBILITY_OPAQUE_CHORD, clamped to [0, 1]:
+// a segment that crosses a surface passes through at least a cell's worth of
+// the cells it made occupied (those within sqrt 3 of it, one layer at least),
+// so it is blocked whole, while one that only clips a cell's corner or edge
+// loses in proportion, and as a patch or receiver moves its visibility changes
+// continuously instead of flipping from 1 to 0 at a cell boundary
+// (docs/algorithm.md section 5, "Voxel visibility").
+const float VISIBILITY_OPAQUE_CHORD = 0.5;
+
+// The visibility of the segment xi -> xj outside the two ends' skipped parts:
+// 1 where it crosses no occupied finest cell, 0 where it runs at least
+// VISIBILITY_OPAQUE_CHORD cells through them, linear between. ni, nj: unit
+// normals of the receiver and the patch (the rise over each one's plane is
+// where the contribution is not 0). A hierarchical DDA: at each point, the
+// coarsest level whose cell there is empty is skipped whole (found from level
+// 1 up); an occupied cell is entered one level finer; an occupied finest cell
+// adds its chord; after leaving a cell the march climbs a level only where it
+// also left the parent cell.
 float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
     vec4 g = u.visibility_grid;
     vec3 a = (xi - g.xyz) / g.w;  // in finest cells
@@ -67,30 +79,35 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
     t0 = max(t0, max(tin.x, max(tin.y, tin.z)));
     t1 = min(t1, min(tout.x, min(tout.y, tout.z)));
     vec3 ahead = vec3(greaterThan(ds, vec3(0.0)));
-    float eps = 1e-3 / length(d);  // a thousandth of a cell along the segment
+    float seg = length(d);         // the segment's length in cells
+    float eps = 1e-3 / seg;        // a thousandth of a cell along the segment
     int top = run.visibility_levels - 1;
     // Start one level up: the march starts near the receiver's surface,
     // where the coarse cells are occupied (it climbs as it leaves parents).
     int k = min(1, top);
     float t = t0;
     ivec3 last_cell = ivec3(run.visibility_side - 1);
-    float visible = 1.0;
+    float inside = 0.0;  // the segment's length inside occupied finest cells
     bool going = t < t1;
     // One cell entered or one level changed.
 #define VISIBILITY_STEP                                                              \
     if (going) {                                                                     \
         ivec3 f = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);               \
         ivec3 c = ivec3(f.x >> k, f.y >> k, f.z >> k);                               \
-        if (grid_occupied(k, c)) {                                                   \
-            if (k == 0) {                                                            \
-                visible = 0.0;                                                       \
-                going = false;                                                       \
-            }                                                                        \
+        bool occupied = grid_occupied(k, c);                                         \
+        if (occupied && k > 0) {                                                     \
             k -= 1;                                                                  \
         } else {                                                                     \
             vec3 far = ((vec3(c) + ahead) * float(1 << k) - a) * inv;                \
-            t = max(t, min(far.x, min(far.y, far.z))) + eps;                         \
-            going = t < t1;                                                          \
+            float leave = min(far.x, min(far.y, far.z));                             \
+            if (occupied) {                                                          \
+                vec3 near = (vec3(c) + (1.0 - ahead) - a) * inv;                     \
+                float enter = max(t0, max(near.x, max(near.y, near.z)));             \
+                float chord = (min(leave, t1) - enter) * seg;                        \
+                inside += chord;                                                     \
+            }                                                                        \
+            t = max(t, leave) + eps;                                                 \
+            going = t < t1 && inside < VISIBILITY_OPAQUE_CHORD;                      \
             ivec3 n = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);           \
             int up = k + 1;                                                          \
             if (k < top && ivec3(n.x >> up, n.y >> up, n.z >> up) != c / 2) k = up;  \
@@ -105,7 +122,7 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
         VISIBILITY_STEP
     }
 #undef VISIBILITY_STEP
-    return visible;
+    return clamp(1.0 - inside / VISIBILITY_OPAQUE_CHORD, 0.0, 1.0);
 }
 
 #endif

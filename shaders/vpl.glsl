@@ -22,7 +22,7 @@ layout(constant_id = 10) const bool VOXEL_VISIBILITY = false;
 // clamped to [0, 1 / (pi d^2 + A_j)] (the cosines' bound every test on the
 // contribution uses: HISR's absolute tau, the restricted splats' quads).
 // V_ij the visibility term every method shares (run.visibility: 1 without,
-// the voxel grid's 0 or 1 with --visibility voxels; docs/algorithm.md
+// the voxel grid's 0 to 1 with --visibility voxels; docs/algorithm.md
 // section 5, "Voxel visibility"). The march runs for every pair, not only
 // where the rest is not 0, so that a list's fragments march together
 // (one march's loop at a time: lavapipe's loop limit, visibility.glsl).
