@@ -26,7 +26,9 @@ layout(constant_id = 10) const bool VOXEL_VISIBILITY = false;
 // section 5, "Voxel visibility"). The march runs for every pair, not only
 // where the rest is not 0, so that a list's fragments march together
 // (one march's loop at a time: lavapipe's loop limit, visibility.glsl).
-vec3 patch_irradiance(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
+// patch_unshadowed is E without V_ij, for a caller that finds V_ij itself
+// (HISR's tile-shared visibility, gather.frag).
+vec3 patch_unshadowed(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
     vec3 v = xj - xi;
     float d2 = dot(v, v);
     vec3 dir = v * inversesqrt(max(d2, 1e-30));
@@ -39,8 +41,13 @@ vec3 patch_irradiance(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int
         float second = cos_i * cos_j * (1.0 + f * (2.0 - 3.0 * cos_j * cos_j)) - f * cos_j * cos_j * dot(ni, nj);
         k = clamp(second / denominator, 0.0, 1.0 / denominator);
     }
-    if (VOXEL_VISIBILITY) k *= voxel_visibility(xi, ni, xj, nj);
     return phi * k;
+}
+
+vec3 patch_irradiance(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
+    vec3 e = patch_unshadowed(xi, ni, xj, nj, phi, a, level);
+    if (VOXEL_VISIBILITY) e *= voxel_visibility(xi, ni, xj, nj);
+    return e;
 }
 
 #endif
