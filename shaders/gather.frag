@@ -20,6 +20,9 @@
 layout(early_fragment_tests) in;
 
 layout(constant_id = 0) const int LIGHT_PATCHES = 0;
+// HISR with tiles and --visibility voxels: the tiles' shared visibility
+// (hisr_visibility.comp, --hisr-shared-visibility).
+layout(constant_id = 1) const bool SHARED_VISIBILITY = false;
 
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
@@ -50,8 +53,16 @@ vec3 e = vec3(0.0);
 uint evaluations = 0u;
 
 // level: patch_level of the patch (patch_irradiance).
-void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux, int level) {
-    e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
+// march: whether to march (patch_irradiance) or apply visibility v. Callers
+// pass a constant: the driver then drops the march where it is false, whose
+// mere presence in the traversal's loop cost lavapipe as much as the rest of
+// the gather.
+void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux, int level, bool march, float v) {
+    if (!march) {
+        e += v * patch_unshadowed(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
+    } else {
+        e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
+    }
     evaluations += 1u;
 }
 
@@ -60,7 +71,7 @@ void patch_list(vec3 xi, vec3 ni) {
         LightPatch lp = patches[j];
         if (lp.position_area.w <= 0.0) continue;  // an empty regular VPL
         // A list's normal.w is the patch's patch_level (vpl_list.comp, isr_select.comp).
-        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, int(lp.normal.w));
+        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, int(lp.normal.w), true, 1.0);
     }
 }
 
@@ -100,7 +111,8 @@ void patch_list(vec3 xi, vec3 ni) {
 // drivers turn each indexed access into selects over all its entries.
 // The nodes come from the packed tree (light_tree_pack.comp, bound as
 // ChosenPatches; node_index in hisr.glsl).
-void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
+// march, v: as add_patch's, for every patch of the walk.
+void traverse_from(vec3 xi, vec3 ni, ivec3 root, bool march, float v) {
     ivec3 node = root;  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     for (;;) {
         LightPatch lp = patches[node_index(node)];
@@ -116,7 +128,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
                 node = ivec3(2 * node.xy, node.z + 1);
                 continue;
             }
-            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, patch_level(run.rsm_top_level - node.z, lp.normal.w));
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, patch_level(run.rsm_top_level - node.z, lp.normal.w), march, v);
         }
         if (!next_node(node, root.z)) return;
     }
@@ -126,7 +138,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root) {
 void traverse(vec3 xi, vec3 ni) {
     int start = run.hisr_start_depth;
     int side = 1 << start;
-    for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start));
+    for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start), true, 1.0);
 }
 
 // From the cuts of the tiles holding texel p of this level (hisr_cut.comp):
@@ -144,6 +156,83 @@ uint tile_at(ivec2 p, int c) {
     return tile.y * lv.x + tile.x;
 }
 
+// HISR's tile-shared visibility (hisr_visibility.comp; docs/algorithm.md
+// section 5, "Tile-shared visibility"): the evaluate entries' visibility from
+// the finest tile's four corner pixels, interpolated bilinearly at the
+// receiver over the corners on its own surface (its tangent plane within a
+// cell, normals within about 25 degrees, both weights falling off smoothly).
+// A receiver with no corner on its surface (at creases and silhouettes)
+// takes the plain bilinear mean of the corners that have geometry. Blending
+// in the receiver's own march where few corners count left the Cornell box
+// as near the per-receiver march as without it and cost the gather 60% more
+// (lavapipe marches a fragment group if one of its fragments does).
+struct SharedVisibility {
+    vec4 weights;  // per corner, normalised over the accepted ones
+    uint base;     // the finest tile's first visibility word
+};
+
+SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
+    SharedVisibility sv;
+    sv.weights = vec4(0.0);
+    sv.base = cut_header.visibility.x + t0 * cut_header.visibility.y;
+    uvec4 finest = cut_header.tiles[0];
+    int side = 1 << finest.z;
+    ivec2 origin = ivec2(t0 % finest.x, t0 / finest.x) * side;
+    // The receiver's centre in pixels (a level's texel covers 2^level of them).
+    vec2 centre = (vec2(p) + 0.5) * float(1 << level);
+    vec2 uv = clamp((centre - (vec2(origin) + 0.5)) / float(side), 0.0, 1.0);
+    vec4 bilinear = vec4((1.0 - uv.x) * (1.0 - uv.y), uv.x * (1.0 - uv.y), (1.0 - uv.x) * uv.y, uv.x * uv.y);
+    vec3 n = normalize(ni);
+    vec4 geometry = vec4(0.0);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 px = min(origin + side * ivec2(k & 1, k >> 1), ivec2(run.output_size) - 1);
+        vec4 x = level0_mean(px);
+        if (x.w <= 0.0) continue;
+        geometry[k] = bilinear[k] + 1e-3;
+        vec3 nk = level0_normal(px).xyz;
+        float plane = abs(dot(nk, xi - x.xyz)) / u.visibility_grid.w;  // in cells
+        float accept = (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk));
+        // A little weight at the far corners too, so a receiver at a
+        // corner that is not on its surface still finds the others.
+        sv.weights[k] = (bilinear[k] + 1e-3) * accept;
+    }
+    float w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
+    if (w <= 0.0) {
+        sv.weights = geometry;
+        w = max(geometry.x + geometry.y + geometry.z + geometry.w, 1e-30);
+    }
+    sv.weights /= w;
+    return sv;
+}
+
+// With shared visibility, the receivers of the finest tiles' levels: every
+// evaluate entry and every walk of a traverse entry takes its visibility
+// from the corners (hisr_visibility.comp), so nothing here marches.
+void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
+    SharedVisibility sv = shared_visibility(xi, ni, p, t0);
+    uint slot = sv.base;  // the visibility words follow the loops' order
+    for (int c = HISR_CUT_LEVELS - 1; c >= 0; --c) {
+        uint t = tile_at(p, c);
+        uint n = (c == 0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
+        uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
+        for (uint i = 0u; i < n; ++i) {
+            uint index = cut[base + i];  // a packed index
+            LightPatch lp = patches[index];
+            float v = dot(sv.weights, unpackUnorm4x8(cut[slot + i]));
+            add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
+                      patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), false, v);
+        }
+        slot += cut_header.capacity[c];
+    }
+    // slot is now past level 0's range: its traverse entries are at its back.
+    uint capacity = cut_header.capacity[0];
+    uint last = cut_header.entries[1] + t0 * capacity + capacity - 1u;
+    for (uint i = 0u; i < counts >> 16; ++i) {
+        float v = dot(sv.weights, unpackUnorm4x8(cut[slot - 1u - i]));
+        traverse_from(xi, ni, cut_node(cut[last - i]), false, v);
+    }
+}
+
 void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
     int c0 = max(level - int(cut_header.tiles[0].z), 0);
     if (c0 >= HISR_CUT_LEVELS) {
@@ -156,6 +245,10 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
         traverse(xi, ni);
         return;
     }
+    if (SHARED_VISIBILITY && c0 == 0) {
+        traverse_cut_shared(xi, ni, p, t0, counts);
+        return;
+    }
     for (int c = HISR_CUT_LEVELS - 1; c >= c0; --c) {
         uint t = tile_at(p, c);
         uint n = (c == c0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
@@ -164,12 +257,12 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
             uint index = cut[base + i];  // a packed index
             LightPatch lp = patches[index];
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
-                      patch_level(run.rsm_top_level - node_depth(index), lp.normal.w));
+                      patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), true, 1.0);
         }
     }
     uint capacity = cut_header.capacity[c0];
     uint last = cut_header.entries[1 + c0] + t0 * capacity + capacity - 1u;
-    for (uint i = 0u; i < counts >> 16; ++i) traverse_from(xi, ni, cut_node(cut[last - i]));
+    for (uint i = 0u; i < counts >> 16; ++i) traverse_from(xi, ni, cut_node(cut[last - i]), true, 1.0);
 }
 
 void main() {

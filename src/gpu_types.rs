@@ -166,7 +166,9 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// (`shaders/hisr_cut.comp`): per level, tiles per row and column, tile level
 /// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
 /// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
-/// `entries[0]` (8 floats a tile); offsets in `u32`s after the
+/// `entries[0]` (8 floats a tile); with shared tile visibility, the evaluate
+/// entries' corner visibilities at `visibility[0]`, `visibility[1]` words per
+/// finest tile (`shaders/hisr_visibility.comp`); offsets in `u32`s after the
 /// header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -174,6 +176,7 @@ pub struct HisrCutHeader {
     pub tiles: [[u32; 4]; HISR_CUT_LEVELS],
     pub entries: [u32; 4],
     pub capacity: [u32; 4],
+    pub visibility: [u32; 4],
 }
 
 /// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.

@@ -79,6 +79,11 @@ impl GatherPass {
                 stencil: stencil.then_some(StencilTest::EQUAL_ONE),
                 specialization: &[
                     (0, source as i32),
+                    (
+                        1,
+                        (source == LightPatches::TiledTraversal && light.cuts_carry_visibility())
+                            as i32,
+                    ),
                     crate::passes::visibility_grid::specialization(setup.settings),
                 ],
                 ..Default::default()

@@ -16,7 +16,7 @@ use crate::gpu_types::{
     HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS, HISR_TAU_ABSOLUTE, HISR_TAU_RELATIVE,
 };
 use crate::multires;
-use crate::passes::{rsm_tree, ComputePass, INDIRECT_COMPUTE};
+use crate::passes::{rsm_tree, visibility_grid, ComputePass, INDIRECT_COMPUTE};
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::barrier;
@@ -118,7 +118,32 @@ pub const TILE_LEVEL: Param<u32> = Param {
     range: Range::closed(0.0, MAX_TILE_LEVEL as f64),
 };
 
-pub const PARAMS: &[&dyn AnyParam] = &[&TAU, &TAU_MODE, &START_LEVEL, &MAX_DEPTH, &TILE_LEVEL];
+pub const SHARED_VISIBILITY: Param<bool> = Param {
+    name: "hisr-shared-visibility",
+    help: "--visibility voxels: the visibility of each tile's shared light patches is marched \
+           from the tile's four corners and interpolated at the receivers (pass \
+           hisr-visibility): 1.4-2.5x HISR without visibility instead of 3.6-4.9x, but off \
+           the per-receiver march by 3-5% on coarse scenes and 19-32% among thin occluders \
+           (docs/algorithm.md section 5); off marches from every receiver",
+    // Off: among thin occluders (`fine`, `slats`) it errs as much as the
+    // grid gains (docs/algorithm.md section 5, "Tile-shared visibility").
+    default: DefaultValue::Fixed(false),
+    range: Range::ANY,
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[
+    &TAU,
+    &TAU_MODE,
+    &START_LEVEL,
+    &MAX_DEPTH,
+    &TILE_LEVEL,
+    &SHARED_VISIBILITY,
+];
+
+/// Whether `hisr-visibility` runs: with the grid, tiles, and sharing on.
+pub fn shares_visibility(s: &RenderSettings) -> bool {
+    visibility_grid::uses_voxels(s) && TILE_LEVEL.get(s) > 0 && SHARED_VISIBILITY.get(s)
+}
 
 /// T at the finest level for `tau` given as a fraction of the light's peak
 /// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2)
@@ -316,6 +341,10 @@ impl LightSpacePass for HisrLightPass {
     fn tile_cuts(&self) -> Option<&Buffer> {
         self.cut.as_ref().map(|c| &c.buffer)
     }
+
+    fn cuts_carry_visibility(&self) -> bool {
+        self.cut.as_ref().is_some_and(|c| c.visibility.is_some())
+    }
 }
 
 /// The most entries a tile's cut holds, per chained level (finest first): the
@@ -329,7 +358,9 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 
 /// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
-/// level's entries, `capacity` per tile.
+/// level's entries, `capacity` per tile; with shared visibility, then a word
+/// per finest tile and slot of every level (outside the budget: 4 MiB at
+/// 256x256, 134 MiB at 1920x1080, stated in the method's memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
@@ -356,6 +387,11 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
         header.entries[1 + c] = offset as u32;
         offset += tiles[c] * capacity;
     }
+    // The evaluate entries' corner visibilities: per finest tile, one word
+    // per slot of every level.
+    if shares_visibility(s) {
+        header.visibility = [offset as u32, header.capacity[..3].iter().sum(), 0, 0];
+    }
     header
 }
 
@@ -373,7 +409,8 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
         .sum();
     let [tx, ty, ..] = header.tiles[0];
     let boxes = 8 * tx as u64 * ty as u64;
-    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes)
+    let visibility = header.visibility[1] as u64 * tx as u64 * ty as u64;
+    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes + visibility)
 }
 
 /// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
@@ -384,6 +421,9 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
 struct CutPass {
     boxes: ComputePass,
     pass: ComputePass,
+    /// Pass `hisr-visibility` (`shaders/hisr_visibility.comp`), with shared
+    /// visibility.
+    visibility: Option<ComputePass>,
     buffer: Buffer,
     header: HisrCutHeader,
 }
@@ -416,9 +456,26 @@ impl CutPass {
                 &[(0, boxes as i32)],
             )
         };
+        let visibility = match shares_visibility(setup.settings) {
+            true => Some(ComputePass::new(
+                setup,
+                "hisr-visibility",
+                "hisr_visibility.comp",
+                &[vec![
+                    Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
+                    Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
+                    Binding::storage("LightTree", tree),
+                    Binding::storage("HisrCut", &buffer),
+                ]],
+                0,
+                &[],
+            )?),
+            false => None,
+        };
         Ok(Self {
             boxes: pass(true)?,
             pass: pass(false)?,
+            visibility,
             buffer,
             header,
         })
@@ -464,6 +521,22 @@ impl CutPass {
             }
             written_for_gather(ctx);
         });
+        if let Some(visibility) = &self.visibility {
+            profiler.pass(gpu, cmd, "hisr-visibility", INDIRECT_COMPUTE, || {
+                // The cuts just written are read here (and the previous
+                // gather's reads of the visibilities were ordered before
+                // hisr-cut's first dispatch).
+                barrier::compute_to_compute(gpu, cmd);
+                // One invocation per slot and finest tile.
+                let [tx, ty, ..] = self.header.tiles[0];
+                let extent = vk::Extent2D {
+                    width: self.header.visibility[1],
+                    height: tx * ty,
+                };
+                visibility.dispatch(ctx, 0, &[], extent);
+                written_for_gather(ctx);
+            });
+        }
     }
 }
 

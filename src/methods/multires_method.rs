@@ -43,6 +43,11 @@ pub trait LightSpacePass {
     fn tile_cuts(&self) -> Option<&Buffer> {
         None
     }
+    /// Whether the tile cuts carry their corners' visibility
+    /// (`hisr-visibility`), which the gather then interpolates.
+    fn cuts_carry_visibility(&self) -> bool {
+        false
+    }
 }
 
 /// What a [`PatchListPass`] writes.
