@@ -62,6 +62,34 @@ fn method_parameters_out_of_range_are_named() {
 }
 
 #[test]
+fn shared_visibility_refuses_more_tiles_than_its_dispatch_holds() {
+    // 16384 x 16384 in 16-pixel tiles: 1,048,576 tiles, 131,072 workgroups
+    // of 8 where Vulkan guarantees 65,535; refused before anything is
+    // allocated.
+    let e = fails(
+        "opt-shared-tiles",
+        &[
+            "--method",
+            "hisr",
+            "--visibility",
+            "voxels",
+            "--hisr-shared-visibility",
+            "on",
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+            "--rsm",
+            "32",
+        ],
+    );
+    assert!(
+        e.contains("--hisr-shared-visibility on takes at most") && e.contains("--hisr-tile-level"),
+        "{e}"
+    );
+}
+
+#[test]
 fn negative_option_values_reach_the_range_check() {
     let dir = temp_dir("opt-negative");
     let e = Isr::tiny(&dir).args(["--tau", "-1"]).fails();

@@ -183,6 +183,19 @@ impl Descriptor for HisrMethod {
                 "--start-level {start} and --max-depth {max} must satisfy start <= max <= log2(--rsm) = {top}"
             );
         }
+        // hisr-visibility's dispatch has a row of 8 finest tiles per workgroup:
+        // Vulkan guarantees 65,535 workgroups a dimension.
+        let [tx, ty, ..] = cut_layout(s).tiles[0];
+        let tiles = tx as u64 * ty as u64;
+        if shares_visibility(s) && tiles.div_ceil(8) > 65_535 {
+            bail!(
+                "--hisr-shared-visibility on takes at most 524,280 tiles, and {}x{} has {tiles} of \
+                 2^{} pixels a side; raise --hisr-tile-level or lower the resolution",
+                s.width,
+                s.height,
+                TILE_LEVEL.get(s)
+            );
+        }
         Ok(())
     }
     /// The packed tree and the tile cuts.
