@@ -300,3 +300,26 @@ fn a_grid_without_voxel_visibility_is_named_as_having_no_effect() {
         .succeeds();
     assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
 }
+
+/// `--hisr-shared-visibility on` without the grid is said to do nothing;
+/// with it, nothing is said.
+#[test]
+fn shared_visibility_without_the_grid_is_named_as_having_no_effect() {
+    let dir = temp_dir("sharing-without-voxels");
+    let warning = "--hisr-shared-visibility on has no effect without --visibility voxels";
+    let ran = Isr::tiny(&dir)
+        .args(["--method", "hisr", "--hisr-shared-visibility", "on"])
+        .succeeds();
+    assert!(ran.stderr.contains(warning), "{}", ran.stderr);
+    let ran = Isr::tiny(&dir)
+        .args([
+            "--method",
+            "hisr",
+            "--visibility",
+            "voxels",
+            "--hisr-shared-visibility",
+            "on",
+        ])
+        .succeeds();
+    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+}

@@ -328,6 +328,9 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(w) = unused_grid_warning(&settings, uses_voxels(&settings)) {
         eprintln!("{w}");
     }
+    if let Some(w) = crate::methods::hisr::unused_sharing_warning(&settings) {
+        eprintln!("{w}");
+    }
     let exact =
         descriptor.takes_exact_visibility() && VISIBILITY.get(&settings) == Visibility::Exact;
     if exact && args.sequence.is_some() {

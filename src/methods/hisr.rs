@@ -140,6 +140,17 @@ pub const PARAMS: &[&dyn AnyParam] = &[
     &SHARED_VISIBILITY,
 ];
 
+/// The warning for `--hisr-shared-visibility on` where it cannot act:
+/// without the grid or without tiles (most likely a forgotten
+/// `--visibility voxels`).
+pub fn unused_sharing_warning(s: &RenderSettings) -> Option<String> {
+    (SHARED_VISIBILITY.get(s) && !shares_visibility(s)).then(|| {
+        "warning: --hisr-shared-visibility on has no effect without --visibility voxels and \
+         --hisr-tile-level above 0"
+            .to_string()
+    })
+}
+
 /// Whether `hisr-visibility` runs: with the grid, tiles, and sharing on.
 pub fn shares_visibility(s: &RenderSettings) -> bool {
     visibility_grid::uses_voxels(s) && TILE_LEVEL.get(s) > 0 && SHARED_VISIBILITY.get(s)
