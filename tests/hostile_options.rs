@@ -277,49 +277,38 @@ fn every_numeric_option_takes_values_with_a_minus_sign() {
     assert!(e.contains("--exposure") && e.contains("finite"), "{e}");
 }
 
+/// `name`'s render with `alone` says `warning`; with `--visibility voxels`
+/// added it says nothing of the kind.
+fn warns_only_without_voxels(name: &str, alone: &[&str], warning: &str) {
+    let dir = temp_dir(name);
+    let ran = Isr::tiny(&dir).args(alone).succeeds();
+    assert!(ran.stderr.contains(warning), "{}", ran.stderr);
+    let ran = Isr::tiny(&dir)
+        .args(alone)
+        .args(["--visibility", "voxels"])
+        .succeeds();
+    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+}
+
 /// `--visibility-grid` without `--visibility voxels` is most likely a
 /// forgotten `--visibility voxels`: the render runs and says the grid has
 /// no effect; with the grid on, nothing is said.
 #[test]
 fn a_grid_without_voxel_visibility_is_named_as_having_no_effect() {
-    let dir = temp_dir("grid-without-voxels");
-    let warning = "--visibility-grid 32 has no effect without --visibility voxels";
-    let ran = Isr::tiny(&dir)
-        .args(["--method", "hisr", "--visibility-grid", "32"])
-        .succeeds();
-    assert!(ran.stderr.contains(warning), "{}", ran.stderr);
-    let ran = Isr::tiny(&dir)
-        .args([
-            "--method",
-            "hisr",
-            "--visibility",
-            "voxels",
-            "--visibility-grid",
-            "32",
-        ])
-        .succeeds();
-    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+    warns_only_without_voxels(
+        "grid-without-voxels",
+        &["--method", "hisr", "--visibility-grid", "32"],
+        "--visibility-grid 32 has no effect without --visibility voxels",
+    );
 }
 
 /// `--hisr-shared-visibility on` without the grid is said to do nothing;
 /// with it, nothing is said.
 #[test]
 fn shared_visibility_without_the_grid_is_named_as_having_no_effect() {
-    let dir = temp_dir("sharing-without-voxels");
-    let warning = "--hisr-shared-visibility on has no effect without --visibility voxels";
-    let ran = Isr::tiny(&dir)
-        .args(["--method", "hisr", "--hisr-shared-visibility", "on"])
-        .succeeds();
-    assert!(ran.stderr.contains(warning), "{}", ran.stderr);
-    let ran = Isr::tiny(&dir)
-        .args([
-            "--method",
-            "hisr",
-            "--visibility",
-            "voxels",
-            "--hisr-shared-visibility",
-            "on",
-        ])
-        .succeeds();
-    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+    warns_only_without_voxels(
+        "sharing-without-voxels",
+        &["--method", "hisr", "--hisr-shared-visibility", "on"],
+        "--hisr-shared-visibility on has no effect without --visibility voxels",
+    );
 }
