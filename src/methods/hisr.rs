@@ -123,7 +123,7 @@ pub const SHARED_VISIBILITY: Param<bool> = Param {
     help: "--visibility voxels: the visibility of each tile's shared light patches is marched \
            from the tile's four corners and interpolated at the receivers (pass \
            hisr-visibility): 1.4-2.5x HISR without visibility instead of 3.6-4.9x, but off \
-           the per-receiver march by 3-5% on coarse scenes and 19-32% among thin occluders \
+           the per-receiver march by 2.5-5.3% on coarse scenes and 9-32% among thin occluders \
            (docs/algorithm.md section 5); off marches from every receiver",
     // Off: among thin occluders (`fine`, `slats`) it errs as much as the
     // grid gains (docs/algorithm.md section 5, "Tile-shared visibility").
