@@ -157,10 +157,10 @@ uint tile_at(ivec2 p, int c) {
 }
 
 // HISR's tile-shared visibility (hisr_visibility.comp; docs/algorithm.md
-// section 5, "Tile-shared visibility"): the evaluate entries' visibility from
-// the finest tile's four corner pixels, interpolated bilinearly at the
-// receiver over the corners on its own surface (its tangent plane within a
-// cell, normals within about 25 degrees, both weights falling off smoothly).
+// section 5, "Tile-shared visibility"): the cut entries' visibility from the
+// finest tile's four corner pixels, interpolated bilinearly at the receiver
+// over the corners on its own surface (its tangent plane within 0.5-1 cell,
+// normals within 26-37 degrees, both weights falling off smoothly).
 // A receiver with no corner on its surface (at creases and silhouettes)
 // takes the plain bilinear mean of the corners that have geometry. Blending
 // in the receiver's own march where few corners count left the Cornell box
@@ -192,9 +192,10 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
         vec3 nk = level0_normal(px).xyz;
         float plane = abs(dot(nk, xi - x.xyz)) / u.visibility_grid.w;  // in cells
         float accept = (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk));
-        // A little weight at the far corners too, so a receiver at a
-        // corner that is not on its surface still finds the others.
-        sv.weights[k] = (bilinear[k] + 1e-3) * accept;
+        // geometry[k] holds a little weight at the far corners too, so a
+        // receiver at a corner that is not on its surface still finds the
+        // others.
+        sv.weights[k] = geometry[k] * accept;
     }
     float w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
     if (w <= 0.0) {

@@ -1,11 +1,12 @@
 #version 460
 // Pass `hisr-visibility` (HISR with --visibility voxels and shared tile
 // visibility, docs/algorithm.md section 5, "Tile-shared visibility"): the
-// evaluate entries of a tile's cut are the same for every receiver in it, so
-// their visibility is marched once from each of the finest tile's four
-// corner pixels instead of once per receiver; the gather interpolates the
-// four for receivers on the corners' surfaces and marches itself elsewhere.
-// One invocation per (evaluate slot, finest tile): x the slot among the three
+// entries of a tile's cut are the same for every receiver in it, so their
+// visibility is marched once from each of the finest tile's four corner
+// pixels instead of once per receiver: the three levels' evaluate entries,
+// and the finest level's traverse entries toward their walk's root. The
+// gather interpolates the four (traverse_cut_shared).
+// One invocation per (slot, finest tile): x the slot among the three
 // levels' capacities (coarsest level first, as the gather sums them), y the
 // finest tile. The four corners are the G-buffer pixels at the tile's
 // corners (the far ones are the next tiles' first pixels, clamped to the
@@ -51,8 +52,10 @@ void main() {
     uint at = tc.y * header.tiles[c].x + tc.x;
     uint counts = cut[header.tiles[c].w + at];
     uint evaluate = counts & 0xffffu;
-    uint e = cut[header.entries[1 + c] + at * header.capacity[c] + i];
+    // Evaluate entries from the front of the range; the finest level's
+    // traverse entries from its back.
     if (i >= evaluate && (c > 0 || i < header.capacity[0] - (counts >> 16))) return;
+    uint e = cut[header.entries[1 + c] + at * header.capacity[c] + i];
     LightPatch lp = nodes[i < evaluate ? e : uint(node_index(cut_node(e)))];
     int side = 1 << finest.z;
     ivec2 origin = ivec2(tile) * side;
@@ -60,7 +63,7 @@ void main() {
     for (int k = 0; k < 4; ++k) {
         ivec2 px = min(origin + side * ivec2(k & 1, k >> 1), ivec2(run.output_size) - 1);
         vec4 x = level0_mean(px);
-        // A corner without geometry is never used (the gather rejects it).
+        // A corner without geometry is never used (the gather gives it no weight).
         if (x.w > 0.0) v[k] = voxel_visibility(x.xyz, level0_normal(px).xyz, lp.position_area.xyz, lp.normal.xyz);
     }
     cut[header.visibility.x + t * header.visibility.y + slot] = packUnorm4x8(v);

@@ -146,9 +146,9 @@ const float HISR_INVALID_TAU_SCALE = 0.01;
 // entries from the back. A count holds the evaluate entries in bits 0-15 and
 // the traverse entries in bits 16-31, or is HISR_CUT_OVERFLOW. Offsets count
 // uints after the header. With the voxel grid and shared tile visibility,
-// then per finest tile one word per evaluate slot of the three levels
-// (coarsest level first): the entry's visibility from the tile's four corner
-// pixels, packUnorm4x8 (hisr_visibility.comp writes it, gather.frag
+// then per finest tile one word per slot of the three levels (coarsest
+// level first; evaluate entries, and the finest level's traverse entries):
+// the entry's visibility from the tile's four corner pixels, packUnorm4x8 (hisr_visibility.comp writes it, gather.frag
 // interpolates it).
 const int HISR_CUT_LEVELS = 3;
 struct HisrCutHeader {
@@ -157,7 +157,7 @@ struct HisrCutHeader {
     uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: of the
                                    // finest tiles' boxes (8 floats each, hisr_cut.comp)
     uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
-    uvec4 visibility;              // x: offset of the evaluate entries' corner visibilities
+    uvec4 visibility;              // x: offset of the entries' corner visibilities
                                    // (hisr_visibility.comp), 0 without them; y: their slots
                                    // per finest tile (the capacities' sum)
 };

@@ -166,7 +166,7 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// (`shaders/hisr_cut.comp`): per level, tiles per row and column, tile level
 /// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
 /// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
-/// `entries[0]` (8 floats a tile); with shared tile visibility, the evaluate
+/// `entries[0]` (8 floats a tile); with shared tile visibility, the
 /// entries' corner visibilities at `visibility[0]`, `visibility[1]` words per
 /// finest tile (`shaders/hisr_visibility.comp`); offsets in `u32`s after the
 /// header.

@@ -493,9 +493,9 @@ fn hisr_shared_tile_visibility_follows_the_per_receiver_march() {
     // shared light patches take their visibility from the tile's corners.
     // On the box with blocks it stays near the per-receiver march, keeps
     // most of what the grid changes, and is validation clean. (In the empty
-    // box it does not meet the 0.5% of the test above: 0.77% away from the
-    // edges at these settings, docs/algorithm.md section 5, so it is off by
-    // default.)
+    // box it does not meet the 0.5% of the test above: it changes the image
+    // without the grid by 0.77% away from the edges at these settings,
+    // docs/algorithm.md section 5, so it is off by default.)
     use isr::methods::hisr::SHARED_VISIBILITY;
     let gpu = validating_gpu();
     let shared = |mut s: RenderSettings| {

@@ -384,7 +384,7 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile; with shared visibility, then a word
 /// per finest tile and slot of every level (outside the budget: 4 MiB at
-/// 256x256, 134 MiB at 1920x1080, stated in the method's memory).
+/// 256x256, 128 MiB at 1920x1080, stated in the method's memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
@@ -411,8 +411,8 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
         header.entries[1 + c] = offset as u32;
         offset += tiles[c] * capacity;
     }
-    // The evaluate entries' corner visibilities: per finest tile, one word
-    // per slot of every level.
+    // The entries' corner visibilities: per finest tile, one word per slot
+    // of every level.
     if shares_visibility(s) {
         header.visibility = [offset as u32, header.capacity[..3].iter().sum(), 0, 0];
     }
