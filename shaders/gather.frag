@@ -23,6 +23,12 @@ layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 // HISR with tiles and --visibility voxels: the tiles' shared visibility
 // (hisr_visibility.comp, --hisr-shared-visibility).
 layout(constant_id = 1) const bool SHARED_VISIBILITY = false;
+// --hisr-shared-refine: the corners' spread past which a receiver marches
+// a patch itself (shared_or_marched); 1 never does.
+layout(constant_id = 2) const float REFINE_SPREAD = 1.0;
+// The distance (in cells) from a corner within which a receiver trusts its
+// visibility fully; at twice it, not at all.
+const float SHARED_REACH = 4.0;
 
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
@@ -162,12 +168,12 @@ uint tile_at(ivec2 p, int c) {
 // over the corners on its own surface (its tangent plane within 0.5-1 cell,
 // normals within 26-37 degrees, both weights falling off smoothly).
 // A receiver with no corner on its surface (at creases and silhouettes)
-// takes the plain bilinear mean of the corners that have geometry. Blending
-// in the receiver's own march where few corners count left the Cornell box
-// as near the per-receiver march as without it and cost the gather 60% more
-// (lavapipe marches a fragment group if one of its fragments does).
+// marches itself (sv.own; with --hisr-shared-refine 1 it takes the plain
+// bilinear mean of the corners that have geometry).
 struct SharedVisibility {
     vec4 weights;  // per corner, normalised over the accepted ones
+    vec4 present;  // 1 per corner with geometry (the same for the whole tile)
+    bool own;      // whether the receiver marches every entry itself
     uint base;     // the finest tile's first visibility word
 };
 
@@ -184,20 +190,29 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     vec4 bilinear = vec4((1.0 - uv.x) * (1.0 - uv.y), uv.x * (1.0 - uv.y), (1.0 - uv.x) * uv.y, uv.x * uv.y);
     vec3 n = normalize(ni);
     vec4 geometry = vec4(0.0);
+    sv.present = vec4(0.0);
     for (int k = 0; k < 4; ++k) {
         ivec2 px = min(origin + side * ivec2(k & 1, k >> 1), ivec2(run.output_size) - 1);
         vec4 x = level0_mean(px);
         if (x.w <= 0.0) continue;
+        sv.present[k] = 1.0;
         geometry[k] = bilinear[k] + 1e-3;
         vec3 nk = level0_normal(px).xyz;
         float plane = abs(dot(nk, xi - x.xyz)) / u.visibility_grid.w;  // in cells
-        float accept = (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk));
+        // A corner far from the receiver, though on its plane (a floor seen
+        // at a grazing angle, a tile's corners under a disc and its
+        // receivers beyond the umbra), sees other occluders.
+        float apart = length(xi - x.xyz) / u.visibility_grid.w;
+        float accept = (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk))
+                     * (1.0 - smoothstep(SHARED_REACH, 2.0 * SHARED_REACH, apart));
         // geometry[k] holds a little weight at the far corners too, so a
         // receiver at a corner that is not on its surface still finds the
         // others.
         sv.weights[k] = geometry[k] * accept;
     }
     float w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
+    // A receiver on none of the corners' surfaces marches itself.
+    sv.own = REFINE_SPREAD < 1.0 && w <= 0.0;
     if (w <= 0.0) {
         sv.weights = geometry;
         w = max(geometry.x + geometry.y + geometry.z + geometry.w, 1e-30);
@@ -206,9 +221,38 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     return sv;
 }
 
+// Whether the receiver marches a patch itself rather than interpolate its
+// corners' visibilities `word`: where the corners with geometry differ by
+// more than --hisr-shared-refine, where none has geometry, or where the
+// receiver is on none of their surfaces (sv.own). Only sv.own differs
+// between the fragments of a tile.
+bool marches(SharedVisibility sv, uint word) {
+    if (REFINE_SPREAD >= 1.0) return false;
+    vec4 c = unpackUnorm4x8(word);
+    vec4 absent = 2.0 * (1.0 - sv.present);
+    float hi = max(max(c.x - absent.x, c.y - absent.y), max(c.z - absent.z, c.w - absent.w));
+    float lo = min(min(c.x + absent.x, c.y + absent.y), min(c.z + absent.z, c.w + absent.w));
+    return sv.own || hi < lo || hi - lo > REFINE_SPREAD;  // hi < lo: no corner has geometry
+}
+
+// The first entry from i below n whose march is `march`; entry k's word is
+// at first + k, or first - k with `back`. The entries are taken in two
+// loops, the interpolated ones and the marched ones, each skipping to its
+// next entry in a loop of loads: lavapipe runs a branch's body under a lane
+// mask even when no lane takes it, so a march behind a branch in the
+// entries' loop cost every entry its set-up (the gather 1.6x with no
+// patch marched).
+uint next_entry(SharedVisibility sv, uint first, bool back, uint i, uint n, bool march) {
+    while (i < n && marches(sv, cut[back ? first - i : first + i]) != march) ++i;
+    return i;
+}
+
 // With shared visibility, the receivers of the finest tiles' levels: every
 // evaluate entry and every walk of a traverse entry takes its visibility
-// from the corners (hisr_visibility.comp), so nothing here marches.
+// from the corners (hisr_visibility.comp) or, where marches() says, from
+// the receiver's own march (a walk's of each of its patches: marching only
+// toward its root left the box with blocks at 128x128 0.026 from the
+// per-receiver march, against 0.018).
 void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
     SharedVisibility sv = shared_visibility(xi, ni, p, t0);
     uint slot = sv.base;  // the visibility words follow the loops' order
@@ -216,21 +260,36 @@ void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
         uint t = tile_at(p, c);
         uint n = (c == 0 ? counts : cut[cut_header.tiles[c].w + t]) & 0xffffu;
         uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
-        for (uint i = 0u; i < n; ++i) {
+        for (uint i = next_entry(sv, slot, false, 0u, n, false); i < n; i = next_entry(sv, slot, false, i + 1u, n, false)) {
             uint index = cut[base + i];  // a packed index
             LightPatch lp = patches[index];
             float v = dot(sv.weights, unpackUnorm4x8(cut[slot + i]));
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
                       patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), false, v);
         }
+        if (REFINE_SPREAD < 1.0) {
+            for (uint i = next_entry(sv, slot, false, 0u, n, true); i < n; i = next_entry(sv, slot, false, i + 1u, n, true)) {
+                uint index = cut[base + i];
+                LightPatch lp = patches[index];
+                add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
+                          patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), true, 1.0);
+            }
+        }
         slot += cut_header.capacity[c];
     }
-    // slot is now past level 0's range: its traverse entries are at its back.
+    // slot is now past level 0's range: its traverse entries are at its
+    // back, entry i's word at slot - 1 - i.
     uint capacity = cut_header.capacity[0];
     uint last = cut_header.entries[1] + t0 * capacity + capacity - 1u;
-    for (uint i = 0u; i < counts >> 16; ++i) {
+    uint walks = counts >> 16;
+    for (uint i = next_entry(sv, slot - 1u, true, 0u, walks, false); i < walks; i = next_entry(sv, slot - 1u, true, i + 1u, walks, false)) {
         float v = dot(sv.weights, unpackUnorm4x8(cut[slot - 1u - i]));
         traverse_from(xi, ni, cut_node(cut[last - i]), false, v);
+    }
+    if (REFINE_SPREAD < 1.0) {
+        for (uint i = next_entry(sv, slot - 1u, true, 0u, walks, true); i < walks; i = next_entry(sv, slot - 1u, true, i + 1u, walks, true)) {
+            traverse_from(xi, ni, cut_node(cut[last - i]), true, 1.0);
+        }
     }
 }
 

@@ -62,34 +62,6 @@ fn method_parameters_out_of_range_are_named() {
 }
 
 #[test]
-fn shared_visibility_refuses_more_tiles_than_its_dispatch_holds() {
-    // 16384 x 16384 in 16-pixel tiles: 1,048,576 tiles, 131,072 workgroups
-    // of 8 where Vulkan guarantees 65,535; refused before anything is
-    // allocated.
-    let e = fails(
-        "opt-shared-tiles",
-        &[
-            "--method",
-            "hisr",
-            "--visibility",
-            "voxels",
-            "--hisr-shared-visibility",
-            "on",
-            "--width",
-            "16384",
-            "--height",
-            "16384",
-            "--rsm",
-            "32",
-        ],
-    );
-    assert!(
-        e.contains("--hisr-shared-visibility on takes at most") && e.contains("--hisr-tile-level"),
-        "{e}"
-    );
-}
-
-#[test]
 fn negative_option_values_reach_the_range_check() {
     let dir = temp_dir("opt-negative");
     let e = Isr::tiny(&dir).args(["--tau", "-1"]).fails();
@@ -302,13 +274,22 @@ fn a_grid_without_voxel_visibility_is_named_as_having_no_effect() {
     );
 }
 
-/// `--hisr-shared-visibility on` without the grid is said to do nothing;
-/// with it, nothing is said.
+/// `--hisr-shared-visibility on` or `--hisr-shared-refine` without the grid
+/// is said to do nothing; with it, nothing is said, and the default (on)
+/// is not named where the grid is off.
 #[test]
 fn shared_visibility_without_the_grid_is_named_as_having_no_effect() {
-    warns_only_without_voxels(
-        "sharing-without-voxels",
-        &["--method", "hisr", "--hisr-shared-visibility", "on"],
-        "--hisr-shared-visibility on has no effect without --visibility voxels",
-    );
+    for (name, args) in [
+        ("sharing-without-voxels", ["--hisr-shared-visibility", "on"]),
+        ("refine-without-voxels", ["--hisr-shared-refine", "0.5"]),
+    ] {
+        warns_only_without_voxels(
+            name,
+            &[&["--method", "hisr"][..], &args].concat(),
+            "has no effect without --visibility voxels, --hisr-shared-visibility on",
+        );
+    }
+    let dir = temp_dir("sharing-default");
+    let ran = Isr::tiny(&dir).args(["--method", "hisr"]).succeeds();
+    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
 }

@@ -37,6 +37,20 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings, method_bytes: u64) -> Resul
             gpu.info.name
         );
     }
+    // The finest-grained dispatch, hisr-visibility's, has a workgroup per
+    // tile of 2 pixels a side at --hisr-tile-level 1.
+    let groups = l.max_compute_work_group_count;
+    if s.width.div_ceil(2) > groups[0] || s.height.div_ceil(2) > groups[1] {
+        bail!(
+            "resolution {}x{} needs more compute workgroups a side than {} dispatches ({}x{}); \
+             choose a smaller --width/--height",
+            s.width,
+            s.height,
+            gpu.info.name,
+            groups[0],
+            groups[1]
+        );
+    }
     let r = s.rsm_resolution;
     if r > max_w.min(max_h) {
         bail!(

@@ -52,6 +52,10 @@ impl GatherPass {
                 .ok_or_else(|| anyhow!("a tiled traversal needs the tile cuts"))?,
             _ => patches,
         };
+        // HISR's tile-shared visibility and its refinement spread.
+        let shared = light
+            .shared_visibility_refine()
+            .filter(|_| source == LightPatches::TiledTraversal);
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let stencil = crate::multires::STENCIL.get(setup.settings);
         let pipeline = PassPipeline::graphics(
@@ -79,11 +83,8 @@ impl GatherPass {
                 stencil: stencil.then_some(StencilTest::EQUAL_ONE),
                 specialization: &[
                     (0, source as i32),
-                    (
-                        1,
-                        (source == LightPatches::TiledTraversal && light.cuts_carry_visibility())
-                            as i32,
-                    ),
+                    (1, shared.is_some() as i32),
+                    (2, shared.unwrap_or(1.0).to_bits() as i32),
                     crate::passes::visibility_grid::specialization(setup.settings),
                 ],
                 ..Default::default()

@@ -122,13 +122,27 @@ pub const SHARED_VISIBILITY: Param<bool> = Param {
     name: "hisr-shared-visibility",
     help: "--visibility voxels: the visibility of each tile's shared light patches is marched \
            from the tile's four corners and interpolated at the receivers (pass \
-           hisr-visibility): 1.4-2.5x HISR without visibility instead of 3.6-4.9x, but off \
-           the per-receiver march by 2.5-5.3% on coarse scenes and 9-32% among thin occluders \
-           (docs/algorithm.md section 5); off marches from every receiver",
-    // Off: among thin occluders (`fine`, `slats`) it errs as much as the
-    // grid gains (docs/algorithm.md section 5, "Tile-shared visibility").
-    default: DefaultValue::Fixed(false),
+           hisr-visibility), each receiver marching itself where the corners disagree \
+           (--hisr-shared-refine): 0.76-1x the per-receiver march's indirect time, as near \
+           the path-traced truth, 1.1x its flicker (docs/algorithm.md section 5); off marches \
+           from every receiver",
+    // On: as accurate against the truth as the per-receiver march, in less
+    // time (docs/algorithm.md section 5, "Tile-shared visibility").
+    default: DefaultValue::Fixed(true),
     range: Range::ANY,
+};
+
+pub const SHARED_REFINE: Param<f32> = Param {
+    name: "hisr-shared-refine",
+    help: "--hisr-shared-visibility on: a receiver marches a light patch itself where the \
+           tile's corners' visibilities of it differ by more than this, where no corner has \
+           geometry, or where no corner within 4-8 cells of it lies on its surface; 0 \
+           wherever they differ at all, 1 never marches",
+    // 0: any difference. 0.25 cost the same and let a thin wall leak 7%
+    // of the light behind it where the corners read 0 and 0.2 (the grid's
+    // chords), docs/algorithm.md section 5.
+    default: DefaultValue::Fixed(0.0),
+    range: Range::closed(0.0, 1.0),
 };
 
 pub const PARAMS: &[&dyn AnyParam] = &[
@@ -138,14 +152,18 @@ pub const PARAMS: &[&dyn AnyParam] = &[
     &MAX_DEPTH,
     &TILE_LEVEL,
     &SHARED_VISIBILITY,
+    &SHARED_REFINE,
 ];
 
-/// The warning for `--hisr-shared-visibility on` where it cannot act:
-/// without the grid or without tiles (most likely a forgotten
-/// `--visibility voxels`).
+/// The warning for `--hisr-shared-visibility on` or `--hisr-shared-refine`
+/// given where they cannot act: without the grid or without tiles (most
+/// likely a forgotten `--visibility voxels`).
 pub fn unused_sharing_warning(s: &RenderSettings) -> Option<String> {
-    (SHARED_VISIBILITY.get(s) && !shares_visibility(s)).then(|| {
-        "warning: --hisr-shared-visibility on has no effect without --visibility voxels and \
+    let given =
+        (SHARED_VISIBILITY.is_set_in(s) && SHARED_VISIBILITY.get(s)) || SHARED_REFINE.is_set_in(s);
+    (given && !shares_visibility(s)).then(|| {
+        "warning: the tiles' shared visibility (--hisr-shared-visibility, --hisr-shared-refine) \
+         has no effect without --visibility voxels, --hisr-shared-visibility on and \
          --hisr-tile-level above 0"
             .to_string()
     })
@@ -192,19 +210,6 @@ impl Descriptor for HisrMethod {
         if max > top || start > max {
             bail!(
                 "--start-level {start} and --max-depth {max} must satisfy start <= max <= log2(--rsm) = {top}"
-            );
-        }
-        // hisr-visibility's dispatch has a row of 8 finest tiles per workgroup:
-        // Vulkan guarantees 65,535 workgroups a dimension.
-        let [tx, ty, ..] = cut_layout(s).tiles[0];
-        let tiles = tx as u64 * ty as u64;
-        if shares_visibility(s) && tiles.div_ceil(8) > 65_535 {
-            bail!(
-                "--hisr-shared-visibility on takes at most 524,280 tiles, and {}x{} has {tiles} of \
-                 2^{} pixels a side; raise --hisr-tile-level or lower the resolution",
-                s.width,
-                s.height,
-                TILE_LEVEL.get(s)
             );
         }
         Ok(())
@@ -366,8 +371,10 @@ impl LightSpacePass for HisrLightPass {
         self.cut.as_ref().map(|c| &c.buffer)
     }
 
-    fn cuts_carry_visibility(&self) -> bool {
-        self.cut.as_ref().is_some_and(|c| c.visibility.is_some())
+    fn shared_visibility_refine(&self) -> Option<f32> {
+        self.cut
+            .as_ref()
+            .and_then(|c| c.visibility.as_ref().map(|_| c.refine))
     }
 }
 
@@ -448,6 +455,8 @@ struct CutPass {
     /// Pass `hisr-visibility` (`shaders/hisr_visibility.comp`), with shared
     /// visibility.
     visibility: Option<ComputePass>,
+    /// `--hisr-shared-refine`, for the gather.
+    refine: f32,
     buffer: Buffer,
     header: HisrCutHeader,
 }
@@ -500,6 +509,7 @@ impl CutPass {
             boxes: pass(true)?,
             pass: pass(false)?,
             visibility,
+            refine: SHARED_REFINE.get(setup.settings),
             buffer,
             header,
         })
@@ -551,11 +561,12 @@ impl CutPass {
                 // gather's reads of the visibilities were ordered before
                 // hisr-cut's first dispatch).
                 barrier::compute_to_compute(gpu, cmd);
-                // One invocation per slot and finest tile.
+                // One workgroup of 8x8 per finest tile (frame::check
+                // holds the tiles a side within the device's workgroups).
                 let [tx, ty, ..] = self.header.tiles[0];
                 let extent = vk::Extent2D {
-                    width: self.header.visibility[1],
-                    height: tx * ty,
+                    width: 8 * tx,
+                    height: 8 * ty,
                 };
                 visibility.dispatch(ctx, 0, &[], extent);
                 written_for_gather(ctx);

@@ -44,9 +44,11 @@ pub trait LightSpacePass {
         None
     }
     /// Whether the tile cuts carry their corners' visibility
-    /// (`hisr-visibility`), which the gather then interpolates.
-    fn cuts_carry_visibility(&self) -> bool {
-        false
+    /// (`hisr-visibility`), which the gather then interpolates, and if so
+    /// the corners' spread past which a receiver marches itself
+    /// (`--hisr-shared-refine`).
+    fn shared_visibility_refine(&self) -> Option<f32> {
+        None
     }
 }
 

@@ -11,7 +11,8 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use std::sync::Arc;
 
-/// Map entries and data for 32-bit integer (or bool) specialization constants.
+/// Map entries and data for 32-bit specialization constants (integers, bools,
+/// or a float's bits).
 fn specialization_data(constants: &[(u32, i32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
     let entries = constants
         .iter()
@@ -107,7 +108,7 @@ pub struct GraphicsDesc<'a> {
     pub blend: Blend,
     /// Cull mode is set per draw (glTF `doubleSided`), so it is dynamic state.
     pub dynamic_cull: bool,
-    /// Integer specialization constants, by constant id.
+    /// 32-bit specialization constants, by constant id (a float as its bits).
     pub specialization: &'a [(u32, i32)],
 }
 
