@@ -166,7 +166,8 @@ uint tile_at(ivec2 p, int c) {
 // section 5, "Tile-shared visibility"): the cut entries' visibility from the
 // finest tile's four corner pixels, interpolated bilinearly at the receiver
 // over the corners on its own surface (its tangent plane within 0.5-1 cell,
-// normals within 26-37 degrees, both weights falling off smoothly).
+// normals within 26-37 degrees, and within 4-8 cells of it, each weight
+// falling off smoothly).
 // A receiver with no corner on its surface (at creases and silhouettes)
 // marches itself (sv.own; with --hisr-shared-refine 1 it takes the plain
 // bilinear mean of the corners that have geometry).
