@@ -24,7 +24,7 @@ layout(constant_id = 0) const int LIGHT_PATCHES = 0;
 // (hisr_visibility.comp, --hisr-shared-visibility).
 layout(constant_id = 1) const bool SHARED_VISIBILITY = false;
 // --hisr-shared-refine: the corners' spread past which a receiver marches
-// a patch itself (shared_or_marched); 1 never does.
+// a patch itself (next_entry; hisr_visibility.comp sets the bits); 1 never does.
 layout(constant_id = 2) const float REFINE_SPREAD = 1.0;
 // The distance (in cells) from a corner within which a receiver trusts its
 // visibility fully; at twice it, not at all.
@@ -173,15 +173,16 @@ uint tile_at(ivec2 p, int c) {
 // bilinear mean of the corners that have geometry).
 struct SharedVisibility {
     vec4 weights;  // per corner, normalised over the accepted ones
-    vec4 present;  // 1 per corner with geometry (the same for the whole tile)
     bool own;      // whether the receiver marches every entry itself
     uint base;     // the finest tile's first visibility word
+    uint bits;     // the finest tile's first word of march bits
 };
 
 SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     SharedVisibility sv;
     sv.weights = vec4(0.0);
     sv.base = cut_header.visibility.x + t0 * cut_header.visibility.y;
+    sv.bits = cut_header.visibility.z + t0 * cut_header.visibility.w;
     uvec4 finest = cut_header.tiles[0];
     int side = 1 << finest.z;
     ivec2 origin = ivec2(t0 % finest.x, t0 / finest.x) * side;
@@ -191,12 +192,10 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     vec4 bilinear = vec4((1.0 - uv.x) * (1.0 - uv.y), uv.x * (1.0 - uv.y), (1.0 - uv.x) * uv.y, uv.x * uv.y);
     vec3 n = normalize(ni);
     vec4 geometry = vec4(0.0);
-    sv.present = vec4(0.0);
     for (int k = 0; k < 4; ++k) {
         ivec2 px = min(origin + side * ivec2(k & 1, k >> 1), ivec2(run.output_size) - 1);
         vec4 x = level0_mean(px);
         if (x.w <= 0.0) continue;
-        sv.present[k] = 1.0;
         geometry[k] = bilinear[k] + 1e-3;
         vec3 nk = level0_normal(px).xyz;
         float plane = abs(dot(nk, xi - x.xyz)) / u.visibility_grid.w;  // in cells
@@ -222,35 +221,36 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     return sv;
 }
 
-// Whether the receiver marches a patch itself rather than interpolate its
-// corners' visibilities `word`: where the corners with geometry differ by
-// more than --hisr-shared-refine, where none has geometry, or where the
-// receiver is on none of their surfaces (sv.own). Only sv.own differs
-// between the fragments of a tile.
-bool marches(SharedVisibility sv, uint word) {
-    if (REFINE_SPREAD >= 1.0) return false;
-    vec4 c = unpackUnorm4x8(word);
-    vec4 absent = 2.0 * (1.0 - sv.present);
-    float hi = max(max(c.x - absent.x, c.y - absent.y), max(c.z - absent.z, c.w - absent.w));
-    float lo = min(min(c.x + absent.x, c.y + absent.y), min(c.z + absent.z, c.w + absent.w));
-    return sv.own || hi < lo || hi - lo > REFINE_SPREAD;  // hi < lo: no corner has geometry
-}
-
-// The first entry from i below n whose march is `march`; entry k's word is
-// at first + k, or first - k with `back`. The entries are taken in two
-// loops, the interpolated ones and the marched ones, each skipping to its
-// next entry in a loop of loads: lavapipe runs a branch's body under a lane
-// mask even when no lane takes it, so a march behind a branch in the
-// entries' loop cost every entry its set-up (the gather 1.6x with no
-// patch marched).
+// The first entry from i below n that the receiver marches itself (`march`)
+// or interpolates; entry k's word is at first + k, or first - k with `back`.
+// It marches every entry where it is on none of the corners' surfaces
+// (sv.own), and otherwise the entries whose march bit hisr_visibility.comp
+// set: the corners with geometry differ by more than --hisr-shared-refine,
+// or none has geometry. Only sv.own differs between the fragments of a
+// tile. The entries are taken in two loops, the interpolated ones and the
+// marched ones, each skipping to its next entry here a word of 32 bits at a
+// time: lavapipe runs a branch's body under a lane mask even when no lane
+// takes it, so a march behind a branch in the entries' loop cost every
+// entry its set-up (the gather 1.6x with no patch marched), and testing
+// every entry's word in the skip cost the marched loop as much again.
 uint next_entry(SharedVisibility sv, uint first, bool back, uint i, uint n, bool march) {
-    while (i < n && marches(sv, cut[back ? first - i : first + i]) != march) ++i;
-    return i;
+    if (REFINE_SPREAD >= 1.0) return march ? n : i;
+    if (sv.own) return march ? i : n;
+    uint flip = march ? 0u : 0xffffffffu;
+    while (i < n) {
+        uint s = (back ? first - i : first + i) - sv.base;  // its slot in the tile
+        uint b = s & 31u;
+        // The bits of the entries from i on in this word.
+        uint bits = (cut[sv.bits + (s >> 5u)] ^ flip) & (back ? 0xffffffffu >> (31u - b) : 0xffffffffu << b);
+        if (bits != 0u) return min(i + (back ? b - uint(findMSB(bits)) : uint(findLSB(bits)) - b), n);
+        i += back ? b + 1u : 32u - b;
+    }
+    return n;
 }
 
 // With shared visibility, the receivers of the finest tiles' levels: every
 // evaluate entry and every walk of a traverse entry takes its visibility
-// from the corners (hisr_visibility.comp) or, where marches() says, from
+// from the corners (hisr_visibility.comp) or, where next_entry() says, from
 // the receiver's own march (a walk's of each of its patches: marching only
 // toward its root left the box with blocks at 128x128 0.026 from the
 // per-receiver march, against 0.018).

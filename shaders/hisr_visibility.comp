@@ -11,6 +11,11 @@
 // first, then the finest level's traverse entries): an invocation per slot
 // of the capacities left most of them idle (some 57 ms of 65-80 on lavapipe
 // at 256x256). Each entry's word goes to its slot, as the gather reads them.
+// Each entry whose corners disagree by more than --hisr-shared-refine, or
+// which no corner with geometry sees, also gets its march bit, so the
+// gather's loops skip to the next entry of their kind by words of 32 slots
+// (testing each entry's word there cost as much as the gather without the
+// grid on lavapipe, most of it in the marched loop's scan).
 // The four corners are the G-buffer pixels at the tile's
 // corners (the far ones are the next tiles' first pixels, clamped to the
 // image), so neighbouring tiles march from the same points.
@@ -20,6 +25,10 @@
 #include "visibility.glsl"
 #include "hisr.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
+
+// --hisr-shared-refine (gather.frag's REFINE_SPREAD): the corners' spread
+// past which every receiver marches an entry itself; 1: none does.
+layout(constant_id = 0) const float REFINE_SPREAD = 1.0;
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
@@ -58,6 +67,13 @@ void main() {
     total += traverse;
     int side = 1 << finest.z;
     ivec2 origin = ivec2(tile) * side;
+    // This frame's march bits start clear (every lane, then the barrier,
+    // before any sets one: the early returns above are the whole
+    // workgroup's).
+    uint bits = header.visibility.z + t * header.visibility.w;
+    for (uint w = gl_LocalInvocationIndex; w < header.visibility.w; w += 64u) cut[bits + w] = 0u;
+    memoryBarrierBuffer();
+    barrier();
     vec4 corner[4];
     vec3 corner_normal[4];
     for (int k = 0; k < 4; ++k) {
@@ -86,10 +102,22 @@ void main() {
         }
         LightPatch lp = nodes[e];
         vec4 v = vec4(1.0);
+        float lo = 1.0, hi = 0.0;
         for (int k = 0; k < 4; ++k) {
             // A corner without geometry is never used (the gather gives it no weight).
-            if (corner[k].w > 0.0) v[k] = voxel_visibility(corner[k].xyz, corner_normal[k], lp.position_area.xyz, lp.normal.xyz);
+            if (corner[k].w > 0.0) {
+                v[k] = voxel_visibility(corner[k].xyz, corner_normal[k], lp.position_area.xyz, lp.normal.xyz);
+                // The spread of the values the gather interpolates (8 bits each).
+                float q = round(v[k] * 255.0) / 255.0;
+                lo = min(lo, q);
+                hi = max(hi, q);
+            }
         }
-        cut[header.visibility.x + t * header.visibility.y + slot + i] = packUnorm4x8(v);
+        slot += i;
+        cut[header.visibility.x + t * header.visibility.y + slot] = packUnorm4x8(v);
+        // hi < lo: no corner has geometry.
+        if (REFINE_SPREAD < 1.0 && (hi < lo || hi - lo > REFINE_SPREAD)) {
+            atomicOr(cut[bits + (slot >> 5u)], 1u << (slot & 31u));
+        }
     }
 }

@@ -149,7 +149,10 @@ const float HISR_INVALID_TAU_SCALE = 0.01;
 // then per finest tile one word per slot of the three levels (coarsest
 // level first; evaluate entries, and the finest level's traverse entries):
 // the entry's visibility from the tile's four corner pixels, packUnorm4x8 (hisr_visibility.comp writes it, gather.frag
-// interpolates it).
+// interpolates it); then per finest tile a bit per slot, set where every
+// receiver marches the entry itself (the corners disagree or none has
+// geometry: hisr_visibility.comp), so the gather finds the entries of each
+// kind a word of 32 slots at a time.
 const int HISR_CUT_LEVELS = 3;
 struct HisrCutHeader {
     uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
@@ -159,7 +162,8 @@ struct HisrCutHeader {
     uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
     uvec4 visibility;              // x: offset of the entries' corner visibilities
                                    // (hisr_visibility.comp), 0 without them; y: their slots
-                                   // per finest tile (the capacities' sum)
+                                   // per finest tile (the capacities' sum); z: offset of
+                                   // the march bits; w: their words per finest tile
 };
 
 // A tile whose cut did not fit: its fragments traverse from the roots.

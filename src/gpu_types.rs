@@ -168,8 +168,9 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
 /// `entries[0]` (8 floats a tile); with shared tile visibility, the
 /// entries' corner visibilities at `visibility[0]`, `visibility[1]` words per
-/// finest tile (`shaders/hisr_visibility.comp`); offsets in `u32`s after the
-/// header.
+/// finest tile, and their march bits at `visibility[2]`, `visibility[3]`
+/// words per finest tile (`shaders/hisr_visibility.comp`); offsets in `u32`s
+/// after the header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct HisrCutHeader {

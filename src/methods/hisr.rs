@@ -123,7 +123,7 @@ pub const SHARED_VISIBILITY: Param<bool> = Param {
     help: "--visibility voxels: the visibility of each tile's shared light patches is marched \
            from the tile's four corners and interpolated at the receivers (pass \
            hisr-visibility), each receiver marching itself where the corners disagree \
-           (--hisr-shared-refine): 0.76-1x the per-receiver march's indirect time, as near \
+           (--hisr-shared-refine): 0.7-1x the per-receiver march's indirect time, as near \
            the path-traced truth, 1.1x its flicker (docs/algorithm.md section 5); off marches \
            from every receiver",
     // On: as accurate against the truth as the per-receiver march, in less
@@ -390,8 +390,9 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile; with shared visibility, then a word
-/// per finest tile and slot of every level (outside the budget: 4 MiB at
-/// 256x256, 128 MiB at 1920x1080, stated in the method's memory).
+/// per finest tile and slot of every level and a bit per slot (outside the
+/// budget: 4.1 MiB at 256x256, 132 MiB at 1920x1080, stated in the method's
+/// memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
@@ -419,9 +420,12 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
         offset += tiles[c] * capacity;
     }
     // The entries' corner visibilities: per finest tile, one word per slot
-    // of every level.
+    // of every level; then a bit per slot, set where the receivers march the
+    // entry themselves (the gather's loops skip by words of these bits).
     if shares_visibility(s) {
-        header.visibility = [offset as u32, header.capacity[..3].iter().sum(), 0, 0];
+        let slots: u32 = header.capacity[..3].iter().sum();
+        let words = offset + tiles[0] * slots as u64;
+        header.visibility = [offset as u32, slots, words as u32, slots.div_ceil(32)];
     }
     header
 }
@@ -440,7 +444,7 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
         .sum();
     let [tx, ty, ..] = header.tiles[0];
     let boxes = 8 * tx as u64 * ty as u64;
-    let visibility = header.visibility[1] as u64 * tx as u64 * ty as u64;
+    let visibility = (header.visibility[1] + header.visibility[3]) as u64 * tx as u64 * ty as u64;
     std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes + visibility)
 }
 
@@ -501,7 +505,8 @@ impl CutPass {
                     Binding::storage("HisrCut", &buffer),
                 ]],
                 0,
-                &[],
+                // REFINE_SPREAD: which entries get their march bit.
+                &[(0, SHARED_REFINE.get(setup.settings).to_bits() as i32)],
             )?),
             false => None,
         };
