@@ -16,6 +16,7 @@
 #include "light_types.glsl"
 #include "vpl.glsl"
 #include "hisr.glsl"
+#include "tile_points.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -26,9 +27,6 @@ layout(constant_id = 1) const bool SHARED_VISIBILITY = false;
 // --hisr-shared-refine: the corners' spread past which a receiver marches
 // a patch itself (next_entry; hisr_visibility.comp sets the bits); 1 never does.
 layout(constant_id = 2) const float REFINE_SPREAD = 1.0;
-// The distance (in cells) from a corner within which a receiver trusts its
-// visibility fully; at twice it, not at all.
-const float SHARED_REACH = 4.0;
 
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
@@ -165,14 +163,16 @@ uint tile_at(ivec2 p, int c) {
 // HISR's tile-shared visibility (hisr_visibility.comp; docs/algorithm.md
 // section 5, "Tile-shared visibility"): the cut entries' visibility from the
 // finest tile's four corner pixels, interpolated bilinearly at the receiver
-// over the corners on its own surface (its tangent plane within 0.5-1 cell,
-// normals within 26-37 degrees, and within 4-8 cells of it, each weight
-// falling off smoothly).
-// A receiver with no corner on its surface (at creases and silhouettes)
-// marches itself (sv.own; with --hisr-shared-refine 1 it takes the plain
-// bilinear mean of the corners that have geometry).
+// over the corners on its own surface (tile_point_weight). A receiver on
+// none of them takes the tile's further points on its surface
+// (hisr_visibility.comp chose them where the corners leave pixels
+// uncovered), and on none of those either (at creases and silhouettes)
+// marches itself (sv.own; with --hisr-shared-refine 1 there are no further
+// points and it takes the plain bilinear mean of the corners that have
+// geometry).
 struct SharedVisibility {
-    vec4 weights;  // per corner, normalised over the accepted ones
+    vec4 weights;  // per corner, or per further point with `points`; normalised
+    bool points;   // whether the weights are the further points'
     bool own;      // whether the receiver marches every entry itself
     uint base;     // the finest tile's first visibility word
     uint bits;     // the finest tile's first word of march bits
@@ -181,6 +181,7 @@ struct SharedVisibility {
 SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     SharedVisibility sv;
     sv.weights = vec4(0.0);
+    sv.points = false;
     sv.base = cut_header.visibility.x + t0 * cut_header.visibility.y;
     sv.bits = cut_header.visibility.z + t0 * cut_header.visibility.w;
     uvec4 finest = cut_header.tiles[0];
@@ -197,21 +198,26 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
         vec4 x = level0_mean(px);
         if (x.w <= 0.0) continue;
         geometry[k] = bilinear[k] + 1e-3;
-        vec3 nk = level0_normal(px).xyz;
-        float plane = abs(dot(nk, xi - x.xyz)) / u.visibility_grid.w;  // in cells
-        // A corner far from the receiver, though on its plane (a floor seen
-        // at a grazing angle, a tile's corners under a disc and its
-        // receivers beyond the umbra), sees other occluders.
-        float apart = length(xi - x.xyz) / u.visibility_grid.w;
-        float accept = (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk))
-                     * (1.0 - smoothstep(SHARED_REACH, 2.0 * SHARED_REACH, apart));
         // geometry[k] holds a little weight at the far corners too, so a
         // receiver at a corner that is not on its surface still finds the
         // others.
-        sv.weights[k] = geometry[k] * accept;
+        sv.weights[k] = geometry[k] * tile_point_weight(xi, n, x.xyz, level0_normal(px).xyz, SHARED_REACH);
     }
     float w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
-    // A receiver on none of the corners' surfaces marches itself.
+    if (w <= 0.0 && cut_header.points.y != 0u) {
+        // The further points on the receiver's surface, by their weights.
+        for (int k = 0; k < TILE_POINTS; ++k) {
+            uint at = cut[cut_header.points.x + t0 * uint(TILE_POINTS) + uint(k)];
+            if (at == TILE_POINT_NONE) break;
+            ivec2 px = ivec2(at & 0xffffu, at >> 16);
+            sv.weights[k] = tile_point_weight(xi, n, level0_mean(px).xyz, level0_normal(px).xyz, POINT_REACH);
+        }
+        w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
+        sv.points = w > 0.0;
+        // Their march bits, from the corners' and the points' spread.
+        if (sv.points) sv.bits = cut_header.points.z + t0 * cut_header.visibility.w;
+    }
+    // A receiver on none of the points' surfaces marches itself.
     sv.own = REFINE_SPREAD < 1.0 && w <= 0.0;
     if (w <= 0.0) {
         sv.weights = geometry;
@@ -219,6 +225,14 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
     }
     sv.weights /= w;
     return sv;
+}
+
+// The interpolated visibility of the entry whose corners' word is at `word`
+// (the further points' word is as far on as their region is from the
+// corners').
+float shared_value(SharedVisibility sv, uint word) {
+    if (sv.points) word += cut_header.points.y - cut_header.visibility.x;
+    return dot(sv.weights, unpackUnorm4x8(cut[word]));
 }
 
 // The first entry from i below n that the receiver marches itself (`march`)
@@ -264,7 +278,7 @@ void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
         for (uint i = next_entry(sv, slot, false, 0u, n, false); i < n; i = next_entry(sv, slot, false, i + 1u, n, false)) {
             uint index = cut[base + i];  // a packed index
             LightPatch lp = patches[index];
-            float v = dot(sv.weights, unpackUnorm4x8(cut[slot + i]));
+            float v = shared_value(sv, slot + i);
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
                       patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), false, v);
         }
@@ -284,7 +298,7 @@ void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
     uint last = cut_header.entries[1] + t0 * capacity + capacity - 1u;
     uint walks = counts >> 16;
     for (uint i = next_entry(sv, slot - 1u, true, 0u, walks, false); i < walks; i = next_entry(sv, slot - 1u, true, i + 1u, walks, false)) {
-        float v = dot(sv.weights, unpackUnorm4x8(cut[slot - 1u - i]));
+        float v = shared_value(sv, slot - 1u - i);
         traverse_from(xi, ni, cut_node(cut[last - i]), false, v);
     }
     if (REFINE_SPREAD < 1.0) {

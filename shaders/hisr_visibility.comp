@@ -24,6 +24,7 @@
 #include "light_types.glsl"
 #include "visibility.glsl"
 #include "hisr.glsl"
+#include "tile_points.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // --hisr-shared-refine (gather.frag's REFINE_SPREAD): the corners' spread
@@ -43,6 +44,9 @@ layout(set = 1, binding = 3, std430) buffer HisrCut {
 };
 #define GEO_LEVEL0_ONLY
 #include "geo_levels.glsl"
+
+// The further point being chosen (tile_points.glsl): its key's minimum.
+shared uint chosen;
 
 void main() {
     uvec2 tile = gl_WorkGroupID.xy;
@@ -71,7 +75,11 @@ void main() {
     // before any sets one: the early returns above are the whole
     // workgroup's).
     uint bits = header.visibility.z + t * header.visibility.w;
-    for (uint w = gl_LocalInvocationIndex; w < header.visibility.w; w += 64u) cut[bits + w] = 0u;
+    uint point_bits = header.points.z + t * header.visibility.w;
+    for (uint w = gl_LocalInvocationIndex; w < header.visibility.w; w += 64u) {
+        cut[bits + w] = 0u;
+        if (header.points.y != 0u) cut[point_bits + w] = 0u;
+    }
     memoryBarrierBuffer();
     barrier();
     vec4 corner[4];
@@ -80,6 +88,54 @@ void main() {
         ivec2 px = min(origin + side * ivec2(k & 1, k >> 1), ivec2(run.output_size) - 1);
         corner[k] = level0_mean(px);
         corner_normal[k] = level0_normal(px).xyz;
+    }
+    // The further points: while some pixel of the tile is on none of the
+    // corners' surfaces (tile_point_weight 0, where the gather's receiver
+    // would march every entry itself) and weighs no chosen point 0.5 or
+    // more, the uncovered pixel nearest the tile's centre (the lowest index
+    // among equals), up to TILE_POINTS of them.
+    vec4 point[TILE_POINTS];
+    vec3 point_normal[TILE_POINTS];
+    int points = 0;
+    if (header.points.y != 0u) {
+        ivec2 size = min(ivec2(side), ivec2(run.output_size) - origin);
+        uint pixels = uint(size.x * size.y);
+        for (int m = 0; m < TILE_POINTS; ++m) {
+            if (gl_LocalInvocationIndex == 0u) chosen = TILE_POINT_NONE;
+            barrier();
+            for (uint q = gl_LocalInvocationIndex; q < pixels; q += 64u) {
+                ivec2 d = ivec2(q % uint(size.x), q / uint(size.x));
+                vec4 x = level0_mean(origin + d);
+                if (x.w <= 0.0) continue;
+                vec3 nx = level0_normal(origin + d).xyz;
+                bool covered = false;
+                for (int k = 0; k < 4; ++k) {
+                    covered = covered || (corner[k].w > 0.0 && tile_point_weight(x.xyz, nx, corner[k].xyz, corner_normal[k], SHARED_REACH) > 0.0);
+                }
+                for (int k = 0; k < m; ++k) {
+                    covered = covered || tile_point_weight(x.xyz, nx, point[k].xyz, point_normal[k], POINT_REACH) >= 0.5;
+                }
+                // Squared distance from the centre in half pixels (clamped
+                // past tiles of 128 pixels a side), then the index (a tile
+                // is at most 256 pixels a side).
+                ivec2 r = 2 * d + 1 - size;
+                uint key = (min(uint(r.x * r.x + r.y * r.y), 0xffffu) << 16) | q;
+                if (!covered) atomicMin(chosen, key);
+            }
+            barrier();
+            uint pick = chosen;
+            // Every lane has read it before lane 0 clears it again.
+            barrier();
+            if (pick == TILE_POINT_NONE) break;
+            ivec2 px = origin + ivec2((pick & 0xffffu) % uint(size.x), (pick & 0xffffu) / uint(size.x));
+            point[m] = level0_mean(px);
+            point_normal[m] = level0_normal(px).xyz;
+            if (gl_LocalInvocationIndex == 0u) cut[header.points.x + t * uint(TILE_POINTS) + uint(m)] = (uint(px.y) << 16) | uint(px.x);
+            points = m + 1;
+        }
+        if (gl_LocalInvocationIndex == 0u && points < TILE_POINTS) {
+            cut[header.points.x + t * uint(TILE_POINTS) + uint(points)] = TILE_POINT_NONE;
+        }
     }
     for (uint j = gl_LocalInvocationIndex; j < total; j += 64u) {
         // Entry j's level c, index i there and slot (the capacities of the
@@ -115,7 +171,30 @@ void main() {
         }
         slot += i;
         cut[header.visibility.x + t * header.visibility.y + slot] = packUnorm4x8(v);
-        // hi < lo: no corner has geometry.
+        if (points > 0) {
+            vec4 w = vec4(1.0);
+            for (int k = 0; k < points; ++k) {
+                w[k] = voxel_visibility(point[k].xyz, point_normal[k], lp.position_area.xyz, lp.normal.xyz);
+            }
+            cut[header.points.y + t * header.visibility.y + slot] = packUnorm4x8(w);
+            // The receivers that take the points march where the corners
+            // and points together disagree (their own bits); where no
+            // corner has geometry, the corners' spread is the points'.
+            float plo = lo, phi = hi;
+            for (int k = 0; k < points; ++k) {
+                float q = round(w[k] * 255.0) / 255.0;
+                plo = min(plo, q);
+                phi = max(phi, q);
+            }
+            if (hi < lo) {
+                lo = plo;
+                hi = phi;
+            }
+            if (REFINE_SPREAD < 1.0 && phi - plo > REFINE_SPREAD) {
+                atomicOr(cut[point_bits + (slot >> 5u)], 1u << (slot & 31u));
+            }
+        }
+        // hi < lo: no corner (nor point) has geometry.
         if (REFINE_SPREAD < 1.0 && (hi < lo || hi - lo > REFINE_SPREAD)) {
             atomicOr(cut[bits + (slot >> 5u)], 1u << (slot & 31u));
         }

@@ -152,7 +152,8 @@ const float HISR_INVALID_TAU_SCALE = 0.01;
 // interpolates it); then per finest tile a bit per slot, set where every
 // receiver marches the entry itself (the corners disagree or none has
 // geometry: hisr_visibility.comp), so the gather finds the entries of each
-// kind a word of 32 slots at a time.
+// kind a word of 32 slots at a time; then (with refinement) the tile's
+// further points, their visibilities and march bits (HisrCutHeader.points).
 const int HISR_CUT_LEVELS = 3;
 struct HisrCutHeader {
     uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
@@ -164,6 +165,11 @@ struct HisrCutHeader {
                                    // (hisr_visibility.comp), 0 without them; y: their slots
                                    // per finest tile (the capacities' sum); z: offset of
                                    // the march bits; w: their words per finest tile
+    uvec4 points;                  // x: offset of the tile points' pixels (4 words per
+                                   // finest tile, (y << 16) | x, ~0u past the last);
+                                   // y: of their visibilities, as the corners' (0 without);
+                                   // z: of their receivers' march bits, as the corners'
+                                   // (tile_points.glsl)
 };
 
 // A tile whose cut did not fit: its fragments traverse from the roots.

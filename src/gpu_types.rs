@@ -169,8 +169,10 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// `entries[0]` (8 floats a tile); with shared tile visibility, the
 /// entries' corner visibilities at `visibility[0]`, `visibility[1]` words per
 /// finest tile, and their march bits at `visibility[2]`, `visibility[3]`
-/// words per finest tile (`shaders/hisr_visibility.comp`); offsets in `u32`s
-/// after the header.
+/// words per finest tile, and the further tile points' pixels at
+/// `points[0]` (4 words per finest tile), their visibilities at `points[1]`
+/// and march bits at `points[2]`, laid out as the corners'
+/// (`shaders/hisr_visibility.comp`); offsets in `u32`s after the header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct HisrCutHeader {
@@ -178,6 +180,7 @@ pub struct HisrCutHeader {
     pub entries: [u32; 4],
     pub capacity: [u32; 4],
     pub visibility: [u32; 4],
+    pub points: [u32; 4],
 }
 
 /// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.

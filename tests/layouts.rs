@@ -176,11 +176,12 @@ fn light_patch_matches_shared_glsl() {
 #[test]
 fn hisr_cut_header_matches_shared_glsl() {
     for shader in ["hisr_cut.comp", "gather.frag", "hisr_visibility.comp"] {
-        check!(shader, HisrCutHeader, "HisrCutHeader", visibility: 16, [
+        check!(shader, HisrCutHeader, "HisrCutHeader", points: 16, [
             tiles => "tiles",
             entries => "entries",
             capacity => "capacity",
             visibility => "visibility",
+            points => "points",
         ]);
     }
 }

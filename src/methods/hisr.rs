@@ -135,9 +135,11 @@ pub const SHARED_VISIBILITY: Param<bool> = Param {
 pub const SHARED_REFINE: Param<f32> = Param {
     name: "hisr-shared-refine",
     help: "--hisr-shared-visibility on: a receiver marches a light patch itself where the \
-           tile's corners' visibilities of it differ by more than this, where no corner has \
-           geometry, or where no corner within 4-8 cells of it lies on its surface; 0 \
-           wherever they differ at all, 1 never marches",
+           tile's corners' visibilities of it differ by more than this, or none has geometry; \
+           one on none of the corners' surfaces takes up to 4 further points of the tile on \
+           its own (marching where they and the corners differ by more than this), and \
+           marches every patch where none is; 0 wherever they differ at all, 1 never marches \
+           (the corners alone)",
     // 0: any difference. 0.25 cost the same and let a thin wall leak 7%
     // of the light behind it where the corners read 0 and 0.2 (the grid's
     // chords), docs/algorithm.md section 5.
@@ -390,9 +392,10 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile; with shared visibility, then a word
-/// per finest tile and slot of every level and a bit per slot (outside the
-/// budget: 4.1 MiB at 256x256, 132 MiB at 1920x1080, stated in the method's
-/// memory).
+/// per finest tile and slot of every level and a bit per slot, and with
+/// refinement the tile points' pixels and a word per slot for them (outside
+/// the budget: 8.3 MiB at 256x256, 263 MiB at 1920x1080, stated in the
+/// method's memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
@@ -426,6 +429,16 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
         let slots: u32 = header.capacity[..3].iter().sum();
         let words = offset + tiles[0] * slots as u64;
         header.visibility = [offset as u32, slots, words as u32, slots.div_ceil(32)];
+        // With refinement, up to 4 more points per tile where the corners
+        // leave receivers uncovered (4 words), their visibilities (a word
+        // per slot, as the corners') and the march bits of the receivers
+        // that take them.
+        if SHARED_REFINE.get(s) < 1.0 {
+            let pixels = words + tiles[0] * slots.div_ceil(32) as u64;
+            let points = pixels + 4 * tiles[0];
+            let point_bits = points + tiles[0] * slots as u64;
+            header.points = [pixels as u32, points as u32, point_bits as u32, 0];
+        }
     }
     header
 }
@@ -444,7 +457,11 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
         .sum();
     let [tx, ty, ..] = header.tiles[0];
     let boxes = 8 * tx as u64 * ty as u64;
-    let visibility = (header.visibility[1] + header.visibility[3]) as u64 * tx as u64 * ty as u64;
+    let mut per_tile = (header.visibility[1] + header.visibility[3]) as u64;
+    if header.points[1] != 0 {
+        per_tile += 4 + (header.visibility[1] + header.visibility[3]) as u64;
+    }
+    let visibility = per_tile * tx as u64 * ty as u64;
     std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes + visibility)
 }
 
