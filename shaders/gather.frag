@@ -201,7 +201,7 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
         // geometry[k] holds a little weight at the far corners too, so a
         // receiver at a corner that is not on its surface still finds the
         // others.
-        sv.weights[k] = geometry[k] * tile_point_weight(xi, n, x.xyz, level0_normal(px).xyz, SHARED_REACH);
+        sv.weights[k] = geometry[k] * tile_point_weight(xi, n, x.xyz, level0_normal(px).xyz);
     }
     float w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
     if (w <= 0.0 && cut_header.points.y != 0u) {
@@ -210,7 +210,7 @@ SharedVisibility shared_visibility(vec3 xi, vec3 ni, ivec2 p, uint t0) {
             uint at = cut[cut_header.points.x + t0 * uint(TILE_POINTS) + uint(k)];
             if (at == TILE_POINT_NONE) break;
             ivec2 px = ivec2(at & 0xffffu, at >> 16);
-            sv.weights[k] = tile_point_weight(xi, n, level0_mean(px).xyz, level0_normal(px).xyz, POINT_REACH);
+            sv.weights[k] = tile_point_weight(xi, n, level0_mean(px).xyz, level0_normal(px).xyz);
         }
         w = sv.weights.x + sv.weights.y + sv.weights.z + sv.weights.w;
         sv.points = w > 0.0;

@@ -110,10 +110,10 @@ void main() {
                 vec3 nx = level0_normal(origin + d).xyz;
                 bool covered = false;
                 for (int k = 0; k < 4; ++k) {
-                    covered = covered || (corner[k].w > 0.0 && tile_point_weight(x.xyz, nx, corner[k].xyz, corner_normal[k], SHARED_REACH) > 0.0);
+                    covered = covered || (corner[k].w > 0.0 && tile_point_weight(x.xyz, nx, corner[k].xyz, corner_normal[k]) > 0.0);
                 }
                 for (int k = 0; k < m; ++k) {
-                    covered = covered || tile_point_weight(x.xyz, nx, point[k].xyz, point_normal[k], POINT_REACH) >= 0.5;
+                    covered = covered || tile_point_weight(x.xyz, nx, point[k].xyz, point_normal[k]) >= 0.5;
                 }
                 // Squared distance from the centre in half pixels (clamped
                 // past tiles of 128 pixels a side), then the index (a tile
@@ -163,10 +163,7 @@ void main() {
             // A corner without geometry is never used (the gather gives it no weight).
             if (corner[k].w > 0.0) {
                 v[k] = voxel_visibility(corner[k].xyz, corner_normal[k], lp.position_area.xyz, lp.normal.xyz);
-                // The spread of the values the gather interpolates (8 bits each).
-                float q = round(v[k] * 255.0) / 255.0;
-                lo = min(lo, q);
-                hi = max(hi, q);
+                widen_spread(lo, hi, v[k]);
             }
         }
         slot += i;
@@ -181,11 +178,7 @@ void main() {
             // and points together disagree (their own bits); where no
             // corner has geometry, the corners' spread is the points'.
             float plo = lo, phi = hi;
-            for (int k = 0; k < points; ++k) {
-                float q = round(w[k] * 255.0) / 255.0;
-                plo = min(plo, q);
-                phi = max(phi, q);
-            }
+            for (int k = 0; k < points; ++k) widen_spread(plo, phi, w[k]);
             if (hi < lo) {
                 lo = plo;
                 hi = phi;
