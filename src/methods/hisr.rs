@@ -24,7 +24,10 @@ use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
 use anyhow::{anyhow, bail, Result};
+
+mod cut_layout;
 use ash::vk;
+pub use cut_layout::{cut_bytes, cut_layout};
 use gpu_allocator::MemoryLocation;
 
 pub const KEY: Method = Method::new("hisr");
@@ -378,91 +381,6 @@ impl LightSpacePass for HisrLightPass {
             .as_ref()
             .and_then(|c| c.visibility.as_ref().map(|_| c.refine))
     }
-}
-
-/// The most entries a tile's cut holds, per chained level (finest first): the
-/// coarsest holds most of each receiver's cut, the finer ones only what they
-/// refine of their parent's traverse entries. All scale down together when
-/// there are so many tiles that the buffer would pass `CUT_BUFFER_BUDGET`. A
-/// tile whose cut does not fit traverses from the roots (the same image,
-/// slower).
-const CUT_CAPACITY: [u64; HISR_CUT_LEVELS] = [1024, 1024, 2048];
-const CUT_BUFFER_BUDGET: u64 = 64 << 20;
-
-/// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
-/// has tiles of 2^(K + c) pixels a side; each level's counts, then each
-/// level's entries, `capacity` per tile; with shared visibility, then a word
-/// per finest tile and slot of every level and a bit per slot, and with
-/// refinement the tile points' pixels and a word per slot for them (outside
-/// the budget: 8.3 MiB at 256x256, 263 MiB at 1920x1080, stated in the
-/// method's memory).
-pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
-    let k = TILE_LEVEL.get(s);
-    let mut header = HisrCutHeader::default();
-    let mut tiles = [0u64; HISR_CUT_LEVELS];
-    let mut offset = 0u64;
-    for (c, level) in header.tiles.iter_mut().enumerate() {
-        let side = 1u32 << (k + c as u32);
-        let (tx, ty) = (s.width.div_ceil(side), s.height.div_ceil(side));
-        tiles[c] = tx as u64 * ty as u64;
-        *level = [tx, ty, k + c as u32, offset as u32];
-        offset += tiles[c];
-    }
-    // The finest tiles' boxes (8 floats each).
-    header.entries[0] = offset as u32;
-    offset += 8 * tiles[0];
-    let full: u64 = (0..HISR_CUT_LEVELS)
-        .map(|c| tiles[c] * CUT_CAPACITY[c])
-        .sum();
-    // Entries over the budget: scale every level's capacity down alike.
-    let scale = (CUT_BUFFER_BUDGET as f64 / 4.0 / full as f64).min(1.0);
-    for c in 0..HISR_CUT_LEVELS {
-        let capacity = ((CUT_CAPACITY[c] as f64 * scale) as u64).max(64);
-        header.capacity[c] = capacity as u32;
-        header.entries[1 + c] = offset as u32;
-        offset += tiles[c] * capacity;
-    }
-    // The entries' corner visibilities: per finest tile, one word per slot
-    // of every level; then a bit per slot, set where the receivers march the
-    // entry themselves (the gather's loops skip by words of these bits).
-    if shares_visibility(s) {
-        let slots: u32 = header.capacity[..3].iter().sum();
-        let words = offset + tiles[0] * slots as u64;
-        header.visibility = [offset as u32, slots, words as u32, slots.div_ceil(32)];
-        // With refinement, up to 4 more points per tile where the corners
-        // leave receivers uncovered (4 words), their visibilities (a word
-        // per slot, as the corners') and the march bits of the receivers
-        // that take them.
-        if SHARED_REFINE.get(s) < 1.0 {
-            let pixels = words + tiles[0] * slots.div_ceil(32) as u64;
-            let points = pixels + 4 * tiles[0];
-            let point_bits = points + tiles[0] * slots as u64;
-            header.points = [pixels as u32, points as u32, point_bits as u32, 0];
-        }
-    }
-    header
-}
-
-/// Bytes of the cut buffer (0 without tiles).
-pub fn cut_bytes(s: &RenderSettings) -> u64 {
-    if TILE_LEVEL.get(s) == 0 {
-        return 0;
-    }
-    let header = cut_layout(s);
-    let entries: u64 = (0..HISR_CUT_LEVELS)
-        .map(|c| {
-            let t = header.tiles[c];
-            t[0] as u64 * t[1] as u64 * (1 + header.capacity[c] as u64)
-        })
-        .sum();
-    let [tx, ty, ..] = header.tiles[0];
-    let boxes = 8 * tx as u64 * ty as u64;
-    let mut per_tile = (header.visibility[1] + header.visibility[3]) as u64;
-    if header.points[1] != 0 {
-        per_tile += 4 + (header.visibility[1] + header.visibility[3]) as u64;
-    }
-    let visibility = per_tile * tx as u64 * ty as u64;
-    std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes + visibility)
 }
 
 /// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
