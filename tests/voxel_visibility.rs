@@ -393,6 +393,21 @@ fn voxel_visibility_on_the_bench_scenes_against_the_truth() {
     }
 }
 
+/// Bench scene `name` at rest, its path-traced truth at 128x128, RSM 128
+/// (noise under 3%), and HISR's indirect radiance there without the grid.
+fn at_rest_with_its_truth(
+    gpu: &isr::vk::Gpu,
+    name: &str,
+) -> (Scene, isr::bench::truth::Truth, Vec<[f32; 4]>) {
+    let mut scene = isr::bench::scenes::build(name).unwrap();
+    scene.animation = None;
+    let s = sized("hisr", 128, 128, 128);
+    let r = render(gpu, &scene, &s, 1);
+    let shadows = ShadowMaps::new(&r.light_views, r.origin, 128, s.pcf_radius);
+    let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
+    (scene, t, r.readback.indirect)
+}
+
 /// Measurement (`cargo test --release --test voxel_visibility -- --ignored
 /// --nocapture hisr_shared`): every bench scene at rest, 128x128, RSM 128
 /// (the bench's size: 8 x 8 tiles), against the path-traced truth (noise
@@ -410,12 +425,8 @@ fn hisr_shared_visibility_on_the_bench_scenes_against_the_truth() {
     println!("| scene | hisr | + voxels 64, per receiver | + shared, refined | + shared, corners only | truth spp, noise |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: |");
     for b in isr::bench::scenes::SCENES {
-        let mut scene = isr::bench::scenes::build(b.name).unwrap();
-        scene.animation = None;
+        let (scene, t, hisr) = at_rest_with_its_truth(&gpu, b.name);
         let s = sized("hisr", 128, 128, 128);
-        let r = render(&gpu, &scene, &s, 1);
-        let shadows = ShadowMaps::new(&r.light_views, r.origin, 128, s.pcf_radius);
-        let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
         let model = |x: &[[f32; 4]]| {
             let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
             (e * e - t.noise * t.noise).max(0.0).sqrt()
@@ -428,7 +439,7 @@ fn hisr_shared_visibility_on_the_bench_scenes_against_the_truth() {
         };
         let per = render(&gpu, &scene, &per_receiver(voxels(s.clone(), 64)), 1).readback;
         let e = [
-            model(&r.readback.indirect),
+            model(&hisr),
             model(&per.indirect),
             model(&shared(SHARED_REFINE.get(&s)).indirect),
             model(&shared(1.0).indirect),
@@ -462,12 +473,7 @@ fn grid_sizes_on_the_bench_scenes_against_the_truth() {
     println!("| scene | method | none | voxels 64 | voxels 128 | voxels 256 | truth noise |");
     println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
     for b in isr::bench::scenes::SCENES {
-        let mut scene = isr::bench::scenes::build(b.name).unwrap();
-        scene.animation = None;
-        let s = sized("hisr", 128, 128, 128);
-        let r = render(&gpu, &scene, &s, 1);
-        let shadows = ShadowMaps::new(&r.light_views, r.origin, 128, s.pcf_radius);
-        let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
+        let (scene, t, _) = at_rest_with_its_truth(&gpu, b.name);
         // The error with the truth's noise taken out, and the mean bias.
         let model = |x: &[[f32; 4]]| {
             let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
