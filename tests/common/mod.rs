@@ -523,3 +523,18 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// `s` with `--visibility voxels` at grid side `n`.
+pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
+    use isr::passes::visibility_grid::{Visibility, GRID, VISIBILITY};
+    VISIBILITY.set(&mut s, Visibility::Voxels);
+    GRID.set(&mut s, n);
+    s
+}
+
+/// `s` with HISR marching from every receiver (`--hisr-shared-visibility
+/// off`; the default shares the tiles' visibility).
+pub fn per_receiver(mut s: RenderSettings) -> RenderSettings {
+    isr::methods::hisr::SHARED_VISIBILITY.set(&mut s, false);
+    s
+}
