@@ -36,15 +36,19 @@ struct Vpl {
 /// Method lpv made by hand on a renderer's targets: the renderer renders
 /// the RSM and G-buffer of its scene (or the test writes them), then the
 /// probe's own `Lpv` records its passes and the grids are read back.
+///
+/// Fields drop in declaration order: the probe's method and profiler first,
+/// then what its descriptors name, the renderer's targets last (the reverse
+/// of creation).
 struct Probe<'g> {
     gpu: &'g Gpu,
-    renderer: Renderer<'g>,
-    frame: FrameSet,
-    _run: Buffer,
-    _grid: Buffer,
-    _samplers: Samplers,
     lpv: Lpv,
     profiler: Profiler,
+    _samplers: Samplers,
+    frame: FrameSet,
+    _grid: Buffer,
+    _run: Buffer,
+    renderer: Renderer<'g>,
 }
 
 impl<'g> Probe<'g> {
@@ -71,13 +75,13 @@ impl<'g> Probe<'g> {
         .expect("lpv");
         Self {
             gpu,
-            renderer,
-            frame,
-            _run: run,
-            _grid: grid,
-            _samplers: samplers,
             lpv,
             profiler: Profiler::new(gpu, 16).unwrap(),
+            _samplers: samplers,
+            frame,
+            _grid: grid,
+            _run: run,
+            renderer,
         }
     }
 

@@ -11,11 +11,10 @@ use isr::renderer::Renderer;
 use isr::scene::{cornell::cornell_box, Scene};
 use isr::settings::RenderSettings;
 use isr::vk::pipeline::{fail_pipeline_creation_after, pipelines_created};
-use isr::vk::Gpu;
 
 /// Drops `gpu` (it must be the device's last holder, so the device really is
 /// destroyed) and returns what the layer reported meanwhile.
-fn destroy(gpu: Gpu) -> Vec<String> {
+fn destroy(gpu: TestGpu) -> Vec<String> {
     let log = gpu.validation_log().expect("validation is on");
     assert_eq!(
         std::sync::Arc::strong_count(&gpu.shared),

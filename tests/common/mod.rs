@@ -26,13 +26,53 @@ pub use isr::bench::metrics::{geometry_mask, relative_rmse};
 
 // Devices.
 
-/// A device with the validation layer loaded when it is installed.
-pub fn gpu() -> Gpu {
+/// Held while a test thread creates or destroys its device. Each test makes
+/// its own instance and device, and the test harness runs them on parallel
+/// threads; creation and destruction are where the loader, the layer and
+/// the driver touch process-wide state (layer libraries, Mesa's shared
+/// compiler state), and CI once saw `tests/lpv.rs` die of SIGSEGV with two
+/// tests in flight (not reproduced here in 45 runs, nor with memcheck, which
+/// was clean). Taking turns there costs nothing measurable; work between
+/// creation and destruction still overlaps.
+static DEVICE_LIFETIMES: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn device_turn() -> std::sync::MutexGuard<'static, ()> {
+    // A test that panicked while holding it left nothing half-made.
+    DEVICE_LIFETIMES
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A test's device: a `Gpu` (through `Deref`) whose creation and
+/// destruction take their turn with other threads' (`DEVICE_LIFETIMES`).
+pub struct TestGpu(Option<Gpu>);
+
+impl std::ops::Deref for TestGpu {
+    type Target = Gpu;
+    fn deref(&self) -> &Gpu {
+        self.0.as_ref().expect("the device lives until drop")
+    }
+}
+
+impl Drop for TestGpu {
+    fn drop(&mut self) {
+        let _turn = device_turn();
+        drop(self.0.take());
+    }
+}
+
+fn test_gpu(validation: Validation) -> anyhow::Result<TestGpu> {
+    let _turn = device_turn();
     Gpu::new(&GpuOptions {
-        validation: Validation::IfInstalled,
+        validation,
         device_index: None,
     })
-    .unwrap_or_else(|e| {
+    .map(|gpu| TestGpu(Some(gpu)))
+}
+
+/// A device with the validation layer loaded when it is installed.
+pub fn gpu() -> TestGpu {
+    test_gpu(Validation::IfInstalled).unwrap_or_else(|e| {
         panic!(
             "this test needs a Vulkan device and found none usable: {e:#}\n\
              Run `bash .ci/install-vulkan` (installs Mesa's lavapipe) and try again."
@@ -41,12 +81,8 @@ pub fn gpu() -> Gpu {
 }
 
 /// A device with the Khronos validation layer, which the test needs.
-pub fn validating_gpu() -> Gpu {
-    Gpu::new(&GpuOptions {
-        validation: Validation::Required,
-        device_index: None,
-    })
-    .unwrap_or_else(|e| {
+pub fn validating_gpu() -> TestGpu {
+    test_gpu(Validation::Required).unwrap_or_else(|e| {
         panic!(
             "{e:#}\nThis test needs the Khronos validation layer: \
              run `bash .ci/install-vulkan --validation`."
