@@ -7,13 +7,16 @@ use super::{shares_visibility, SHARED_REFINE, TILE_LEVEL};
 use crate::gpu_types::{HisrCutHeader, HISR_CUT_LEVELS};
 use crate::settings::RenderSettings;
 
-/// The most entries a tile's cut holds, per chained level (finest first): the
-/// coarsest holds most of each receiver's cut, the finer ones only what they
-/// refine of their parent's traverse entries. All scale down together when
-/// there are so many tiles that the buffer would pass `CUT_BUFFER_BUDGET`. A
-/// tile whose cut does not fit traverses from the roots (the same image,
-/// slower).
-const CUT_CAPACITY: [u64; HISR_CUT_LEVELS] = [1024, 1024, 2048];
+/// The most entries a tile's cut holds, per chained level (finest first). All
+/// scale down together when there are so many tiles that the buffer would
+/// pass `CUT_BUFFER_BUDGET` (above about 1600x1000). A tile whose cut does
+/// not fit traverses from the roots: the same image without the grid,
+/// slower; with it, its receivers march every patch instead of sharing the
+/// tile's visibility. 2048 at every level: `slats` (up to 3,764 light patches
+/// per eye patch at 256x256, RSM 256) overflowed 1024 at the two finer
+/// levels and 1024 at the coarsest, and with the grid took 1.7x as long
+/// (docs/algorithm.md section 5, "Tile-shared visibility").
+const CUT_CAPACITY: [u64; HISR_CUT_LEVELS] = [2048, 2048, 2048];
 const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 
 /// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
@@ -21,7 +24,7 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// level's entries, `capacity` per tile; with shared visibility, then a word
 /// per finest tile and slot of every level and a bit per slot, and with
 /// refinement the tile points' pixels and a word per slot for them (outside
-/// the budget: 8.3 MiB at 256x256, 263 MiB at 1920x1080, stated in the
+/// the budget: 12.4 MiB at 256x256, 302 MiB at 1920x1080, stated in the
 /// method's memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
