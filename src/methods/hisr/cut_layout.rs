@@ -19,33 +19,70 @@ use crate::settings::RenderSettings;
 const CUT_CAPACITY: [u64; HISR_CUT_LEVELS] = [2048, 2048, 2048];
 const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 
+/// The most bytes the cut buffer may take with the visibility words: 2^27,
+/// the least `maxStorageBufferRange` a Vulkan device may have, so that one
+/// descriptor binds it on every device. Past it (shared visibility from
+/// about 760x760 on), every capacity scales down further.
+const CUT_BUFFER_LIMIT: u64 = 1 << 27;
+
 /// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile; with shared visibility, then a word
 /// per finest tile and slot of every level and a bit per slot, and with
 /// refinement the tile points' pixels and a word per slot for them (outside
-/// the budget: 12.4 MiB at 256x256, 302 MiB at 1920x1080, stated in the
-/// method's memory).
+/// the entries' budget, within `CUT_BUFFER_LIMIT`: 12.4 MiB at 256x256,
+/// stated in the method's memory).
 pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
+    let tiles = tiles(s);
+    let full: u64 = (0..HISR_CUT_LEVELS)
+        .map(|c| tiles[c] * CUT_CAPACITY[c])
+        .sum();
+    // Entries over the budget: scale every level's capacity down alike.
+    let mut scale = (CUT_BUFFER_BUDGET as f64 / 4.0 / full as f64).min(1.0);
+    let mut header = layout_at(s, scale);
+    // Then the whole buffer over the limit: shrink by the ratio until it
+    // fits (the part that does not scale, the counts and boxes, is small,
+    // so a few rounds do).
+    for _ in 0..16 {
+        let bytes = header_bytes(&header);
+        if bytes <= CUT_BUFFER_LIMIT {
+            break;
+        }
+        scale *= CUT_BUFFER_LIMIT as f64 / bytes as f64;
+        header = layout_at(s, scale);
+    }
+    header
+}
+
+/// Tiles of each chained level of `s`.
+fn tiles(s: &RenderSettings) -> [u64; HISR_CUT_LEVELS] {
+    let k = TILE_LEVEL.get(s);
+    std::array::from_fn(|c| {
+        let side = 1u32 << (k + c as u32);
+        s.width.div_ceil(side) as u64 * s.height.div_ceil(side) as u64
+    })
+}
+
+/// The layout of `s` with every level's capacity `CUT_CAPACITY` times
+/// `scale` (at least 64).
+fn layout_at(s: &RenderSettings, scale: f64) -> HisrCutHeader {
     let k = TILE_LEVEL.get(s);
     let mut header = HisrCutHeader::default();
-    let mut tiles = [0u64; HISR_CUT_LEVELS];
+    let tiles = tiles(s);
     let mut offset = 0u64;
     for (c, level) in header.tiles.iter_mut().enumerate() {
         let side = 1u32 << (k + c as u32);
-        let (tx, ty) = (s.width.div_ceil(side), s.height.div_ceil(side));
-        tiles[c] = tx as u64 * ty as u64;
-        *level = [tx, ty, k + c as u32, offset as u32];
+        *level = [
+            s.width.div_ceil(side),
+            s.height.div_ceil(side),
+            k + c as u32,
+            offset as u32,
+        ];
         offset += tiles[c];
     }
     // The finest tiles' boxes (8 floats each).
     header.entries[0] = offset as u32;
     offset += 8 * tiles[0];
-    let full: u64 = (0..HISR_CUT_LEVELS)
-        .map(|c| tiles[c] * CUT_CAPACITY[c])
-        .sum();
-    // Entries over the budget: scale every level's capacity down alike.
-    let scale = (CUT_BUFFER_BUDGET as f64 / 4.0 / full as f64).min(1.0);
     for c in 0..HISR_CUT_LEVELS {
         let capacity = ((CUT_CAPACITY[c] as f64 * scale) as u64).max(64);
         header.capacity[c] = capacity as u32;
@@ -78,7 +115,11 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
     if TILE_LEVEL.get(s) == 0 {
         return 0;
     }
-    let header = cut_layout(s);
+    header_bytes(&cut_layout(s))
+}
+
+/// Bytes of the cut buffer `header` lays out.
+fn header_bytes(header: &HisrCutHeader) -> u64 {
     let entries: u64 = (0..HISR_CUT_LEVELS)
         .map(|c| {
             let t = header.tiles[c];
@@ -93,4 +134,54 @@ pub fn cut_bytes(s: &RenderSettings) -> u64 {
     }
     let visibility = per_tile * tx as u64 * ty as u64;
     std::mem::size_of::<HisrCutHeader>() as u64 + 4 * (entries + boxes + visibility)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::passes::visibility_grid::{Visibility, VISIBILITY};
+    use crate::settings::Method;
+
+    fn hisr(width: u32, height: u32, grid: bool) -> RenderSettings {
+        let mut s = RenderSettings {
+            width,
+            height,
+            method: Method::new("hisr"),
+            ..Default::default()
+        };
+        if grid {
+            VISIBILITY.set(&mut s, Visibility::Voxels);
+        }
+        s
+    }
+
+    /// Within the least `maxStorageBufferRange` a device may have at every
+    /// size, with shared visibility or without; the capacities stay whole at
+    /// the bench's sizes, and shrink no more than the limit needs.
+    #[test]
+    fn the_cut_buffer_fits_one_descriptor_on_every_device() {
+        for (w, h) in [
+            (128, 128),
+            (256, 256),
+            (1024, 768),
+            (1920, 1080),
+            (3840, 2160),
+        ] {
+            for grid in [false, true] {
+                let s = hisr(w, h, grid);
+                let header = cut_layout(&s);
+                let bytes = cut_bytes(&s);
+                assert!(bytes <= CUT_BUFFER_LIMIT, "{w}x{h} {grid}: {bytes}");
+                assert_eq!(shares_visibility(&s), grid);
+                if w <= 256 {
+                    assert_eq!(header.capacity[..3], [2048; 3], "{w}x{h} {grid}");
+                } else if grid {
+                    // Two more entries per level would not fit.
+                    let c = header.capacity[0] as f64;
+                    let more = layout_at(&s, (c + 2.5) / 2048.0);
+                    assert!(header_bytes(&more) > CUT_BUFFER_LIMIT, "{w}x{h}: {c}");
+                }
+            }
+        }
+    }
 }
