@@ -485,3 +485,35 @@ fn hisr_shared_tile_visibility_follows_the_per_receiver_march() {
     );
     assert_validation_clean(&gpu);
 }
+
+#[test]
+fn a_grid_past_the_devices_storage_buffer_range_is_refused_before_allocation() {
+    // At 1024 the grid takes 147 MiB, more than the 128 MiB lavapipe binds
+    // in one storage buffer: the run is refused with the grid that fits,
+    // before anything is allocated (validation would report the binding).
+    use isr::passes::visibility_grid::grid_bytes;
+    let gpu = validating_gpu();
+    let range = gpu.limits().max_storage_buffer_range as u64;
+    let scene = cornell_at_rest(false);
+    let s = voxels(sized("reference", 16, 16, 16), 1024);
+    if grid_bytes(1024) > range {
+        let e = isr::renderer::Renderer::new(&gpu, &scene, &s)
+            .err()
+            .expect("a grid past the range is refused")
+            .to_string();
+        let fits = (4..=10)
+            .map(|k| 1u32 << k)
+            .filter(|&n| grid_bytes(n) <= range)
+            .max()
+            .unwrap();
+        assert!(
+            e.contains("--visibility-grid 1024")
+                && e.contains("maxStorageBufferRange")
+                && e.contains(&format!("choose --visibility-grid {fits} or less")),
+            "{e}"
+        );
+    } else {
+        println!("this device binds {range} bytes at once: the 1024 grid fits");
+    }
+    assert_validation_clean(&gpu);
+}

@@ -145,6 +145,28 @@ pub fn check(s: &RenderSettings, method: &str, reads_exact: bool) -> Result<()> 
     Ok(())
 }
 
+/// Checks, before anything is allocated, that the grid of `s` fits the one
+/// storage buffer `gpu` binds it as: at 1024 it takes 147 MiB, past the
+/// 128 MiB that some devices (lavapipe among them) bind at once.
+pub fn check_device(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
+    let (bytes, range) = (memory(s), gpu.limits().max_storage_buffer_range as u64);
+    if bytes > range {
+        let mut fits = GRID.get(s);
+        while fits > 16 && grid_bytes(fits) > range {
+            fits /= 2;
+        }
+        bail!(
+            "--visibility-grid {}: the grid takes {} MiB, more than {} binds in one buffer \
+             (maxStorageBufferRange: {} MiB); choose --visibility-grid {fits} or less",
+            GRID.get(s),
+            bytes.div_ceil(1 << 20),
+            gpu.info.name,
+            range >> 20
+        );
+    }
+    Ok(())
+}
+
 /// The visibility fields of the run uniforms.
 pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
     let n = GRID.get(s);

@@ -559,6 +559,7 @@ fn check_run(
     let d = crate::methods::check(settings)?;
     let method = crate::methods::memory(d, settings);
     check_settings(gpu, settings, method)?;
+    crate::passes::visibility_grid::check_device(gpu, settings)?;
     let cube_rsm = match lights.iter().any(|l| l.kind == LightKind::Point) {
         true => crate::passes::rsm_cube::cube_bytes(settings.rsm_resolution),
         false => 0,

@@ -118,6 +118,30 @@ pub struct DescriptorSet {
 
 impl DescriptorSet {
     pub fn new(gpu: &Gpu, name: &str, bindings: &[Binding]) -> Result<Self> {
+        // One descriptor binds a whole buffer: past the device's range it
+        // would read out of bounds, and validation would report it.
+        let l = gpu.limits();
+        for b in bindings {
+            let (buffer, limit, what) = match b.resource {
+                Resource::Storage(buf) => {
+                    (buf, l.max_storage_buffer_range, "maxStorageBufferRange")
+                }
+                Resource::Uniform(buf) => {
+                    (buf, l.max_uniform_buffer_range, "maxUniformBufferRange")
+                }
+                _ => continue,
+            };
+            if buffer.size > limit as u64 {
+                bail!(
+                    "{name}: buffer {} takes {} MiB, more than {} binds at once ({what}: {} MiB); \
+                     choose a smaller resolution, --rsm or --visibility-grid",
+                    b.name,
+                    buffer.size.div_ceil(1 << 20),
+                    gpu.info.name,
+                    limit >> 20
+                );
+            }
+        }
         let stages = vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE;
         let layout_bindings: Vec<_> = bindings
             .iter()
