@@ -194,10 +194,7 @@ fn exact_visibility_brings_the_dense_reference_to_the_truth_in_the_box_with_bloc
     let exact = gather(&r.readback, &vpls, Some(&o), |_, _| {});
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
     let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
-    let model = |x: &[[f32; 4]]| {
-        let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-        (e * e - t.noise * t.noise).max(0.0).sqrt()
-    };
+    let model = |x: &[[f32; 4]]| model_error(x, &t);
     let (with, without) = (model(&exact), model(&r.readback.indirect));
     println!(
         "against the truth ({} spp, noise {:.4}, noise taken out): {without:.4} without visibility, {with:.4} with exact visibility",

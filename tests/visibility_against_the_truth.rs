@@ -33,10 +33,7 @@ fn voxel_visibility_on_the_bench_scenes_against_the_truth() {
         let r = render(&gpu, &scene, &settings, 1);
         let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
         let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
-        let model = |x: &[[f32; 4]]| {
-            let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-            (e * e - t.noise * t.noise).max(0.0).sqrt()
-        };
+        let model = |x: &[[f32; 4]]| model_error(x, &t);
         let vox = render(&gpu, &scene, &voxels(settings.clone(), 64), 1).readback;
         let fine = render(&gpu, &scene, &voxels(settings.clone(), 256), 1).readback;
         let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
@@ -94,10 +91,7 @@ fn hisr_shared_visibility_on_the_bench_scenes_against_the_truth() {
     for b in isr::bench::scenes::SCENES {
         let (scene, t, hisr) = at_rest_with_its_truth(&gpu, b.name);
         let s = sized("hisr", 128, 128, 128);
-        let model = |x: &[[f32; 4]]| {
-            let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-            (e * e - t.noise * t.noise).max(0.0).sqrt()
-        };
+        let model = |x: &[[f32; 4]]| model_error(x, &t);
         let shared = |refine: f32| {
             let mut v = voxels(s.clone(), 64);
             SHARED_VISIBILITY.set(&mut v, true);
@@ -143,7 +137,6 @@ fn grid_sizes_on_the_bench_scenes_against_the_truth() {
         let (scene, t, _) = at_rest_with_its_truth(&gpu, b.name);
         // The error with the truth's noise taken out, and the mean bias.
         let model = |x: &[[f32; 4]]| {
-            let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
             let (mut sum, mut truth) = (0.0f64, 0.0f64);
             for ((p, q), _) in x
                 .iter()
@@ -154,10 +147,7 @@ fn grid_sizes_on_the_bench_scenes_against_the_truth() {
                 sum += (p[0] + p[1] + p[2]) as f64;
                 truth += (q[0] + q[1] + q[2]) as f64;
             }
-            (
-                (e * e - t.noise * t.noise).max(0.0).sqrt(),
-                sum / truth - 1.0,
-            )
+            (model_error(x, &t), sum / truth - 1.0)
         };
         for method in ["reference", "hisr"] {
             let s = sized(method, 128, 128, 128);
@@ -210,10 +200,7 @@ fn hisr_tau_with_the_grid_against_the_truth() {
     println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for b in isr::bench::scenes::SCENES {
         let (scene, t, hisr) = at_rest_with_its_truth(&gpu, b.name);
-        let model = |x: &[[f32; 4]]| {
-            let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-            (e * e - t.noise * t.noise).max(0.0).sqrt()
-        };
+        let model = |x: &[[f32; 4]]| model_error(x, &t);
         let at = |tau: f32, grid: bool| {
             let mut s = sized("hisr", 128, 128, 128);
             if grid {

@@ -188,10 +188,7 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
     assert!(errors[4] < 0.25 * none, "{errors:?} against {none}");
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
     let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
-    let model = |x: &[[f32; 4]]| {
-        let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-        (e * e - t.noise * t.noise).max(0.0).sqrt()
-    };
+    let model = |x: &[[f32; 4]]| model_error(x, &t);
     let without = model(&r.readback.indirect);
     println!(
         "against the truth ({} spp, noise {:.4}, noise taken out): {without:.4} without visibility, {:.4} exact",
