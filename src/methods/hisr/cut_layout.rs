@@ -54,13 +54,18 @@ pub fn cut_layout(s: &RenderSettings) -> HisrCutHeader {
     header
 }
 
-/// Tiles of each chained level of `s`.
-fn tiles(s: &RenderSettings) -> [u64; HISR_CUT_LEVELS] {
+/// Tiles across and down of each chained level of `s`.
+fn tile_counts(s: &RenderSettings) -> [[u32; 2]; HISR_CUT_LEVELS] {
     let k = TILE_LEVEL.get(s);
     std::array::from_fn(|c| {
         let side = 1u32 << (k + c as u32);
-        s.width.div_ceil(side) as u64 * s.height.div_ceil(side) as u64
+        [s.width.div_ceil(side), s.height.div_ceil(side)]
     })
+}
+
+/// Tiles of each chained level of `s`.
+fn tiles(s: &RenderSettings) -> [u64; HISR_CUT_LEVELS] {
+    tile_counts(s).map(|[tx, ty]| tx as u64 * ty as u64)
 }
 
 /// The layout of `s` with every level's capacity `CUT_CAPACITY` times
@@ -70,14 +75,8 @@ fn layout_at(s: &RenderSettings, scale: f64) -> HisrCutHeader {
     let mut header = HisrCutHeader::default();
     let tiles = tiles(s);
     let mut offset = 0u64;
-    for (c, level) in header.tiles.iter_mut().enumerate() {
-        let side = 1u32 << (k + c as u32);
-        *level = [
-            s.width.div_ceil(side),
-            s.height.div_ceil(side),
-            k + c as u32,
-            offset as u32,
-        ];
+    for (c, (level, [tx, ty])) in header.tiles.iter_mut().zip(tile_counts(s)).enumerate() {
+        *level = [tx, ty, k + c as u32, offset as u32];
         offset += tiles[c];
     }
     // The finest tiles' boxes (8 floats each).
