@@ -205,6 +205,12 @@ struct VisibilityGridPush {
     uint triangles;       // this dispatch's triangle count
 };
 
+// Push constants of one dispatch of pass visibility-grid's OR-levels
+// (visibility_grid_levels.comp).
+struct VisibilityGridLevelPush {
+    int level;  // the level it reads; it writes level + 1
+};
+
 // Push constants of one scene draw.
 struct DrawPush {
     uint instance;  // index into the frame's InstanceTransform array

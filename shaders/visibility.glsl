@@ -3,25 +3,16 @@
 // light patch crosses an occupied cell. The grid is this frame's posed
 // scene, conservatively voxelized by visibility_grid.comp: N^3 finest cells
 // over the cube u.visibility_grid, and OR-levels k = 1.. of side N >> k
-// (a level-k cell is occupied iff one of its 8^k finest cells is), one bit
-// per cell, x fastest, level after level in one buffer.
+// (a level-k cell is occupied iff one of its 8^k finest cells is:
+// visibility_grid_levels.comp), laid out as visibility_layout.glsl says.
 #ifndef VISIBILITY_GLSL
 #define VISIBILITY_GLSL
-#include "frame.glsl"
+#include "visibility_layout.glsl"
 
 layout(set = 0, binding = 3, std430) readonly buffer VisibilityGrid { uint visibility_bits[]; };
 
-// Words before level k: sum over i < k of (N >> i)^3 / 32 = (N^3 - (N >> k)^3) / 28
-// (a geometric sum of ratio 1/8; every level has at least 4^3 cells, so whole words).
-uint grid_level_offset(int k) {
-    uint n = uint(run.visibility_side);
-    uint m = n >> uint(k);
-    return (n * n * n - m * m * m) / 28u;
-}
-
 bool grid_occupied(int k, ivec3 c) {
-    int n = run.visibility_side >> k;
-    uint i = uint((c.z * n + c.y) * n + c.x);
+    uint i = grid_cell_index(k, c);
     return (visibility_bits[grid_level_offset(k) + (i >> 5u)] & (1u << (i & 31u))) != 0u;
 }
 

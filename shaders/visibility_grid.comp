@@ -1,12 +1,13 @@
 #version 460
-// Pass visibility-grid (docs/algorithm.md section 5, "Voxel visibility"): the
-// occupancy grid of this frame's posed scene, one invocation per triangle of
-// one instance (placed by this frame's InstanceTransform). Every cell, at
-// every level, that the triangle touches gets its bit set with atomicOr, so
-// the result does not depend on the order triangles run in. Each level is
-// voxelized on its own (a level-k cell is a box of 2^k finest cells): a
-// triangle touches a coarse cell iff it touches one of its children, so this
-// is the OR of the finer level without a pass or a barrier between levels.
+// Pass visibility-grid, its first dispatches (docs/algorithm.md section 5,
+// "Voxel visibility"): the finest level of the occupancy grid of this
+// frame's posed scene, one invocation per triangle of one instance (placed
+// by this frame's InstanceTransform) and tile of columns. Every finest cell
+// the triangle touches gets its bit set with atomicOr, so the result does
+// not depend on the order triangles run in. The coarser levels are ORs of
+// this one, made after it by visibility_grid_levels.comp (voxelizing every
+// level here took about 70% of the pass on the 277k triangles of the
+// conference room).
 //
 // The test is the separating-axis test of a triangle and a box (Akenine-Moller
 // 2001), made conservative by a small margin: the box's face normals come
@@ -17,14 +18,14 @@
 //
 // Lavapipe ends a shader invocation's loops after 65,535 iterations
 // together, so one invocation covers one tile of VISIBILITY_TILE x
-// VISIBILITY_TILE columns (gl_GlobalInvocationID.y; levels no wider than a
-// tile are covered by tile 0 alone): at most 3 cells per column, since the
+// VISIBILITY_TILE columns (gl_GlobalInvocationID.y; a grid no wider than a
+// tile is covered by tile 0 alone): at most 3 cells per column, since the
 // columns run along the normal's dominant axis.
 #extension GL_GOOGLE_include_directive : require
-#include "frame.glsl"
+#include "visibility_layout.glsl"
 layout(local_size_x = 64) in;
 
-// Cleared before the dispatch (visibility_grid.rs); layout in visibility.glsl.
+// Cleared before the dispatch (visibility_grid.rs).
 layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
 layout(set = 1, binding = 0, std430) readonly buffer Vertices { float vertex_data[]; };  // GpuVertex: 8 floats
 layout(set = 1, binding = 1, std430) readonly buffer Indices { uint index_data[]; };
@@ -35,12 +36,6 @@ const float MARGIN = 1e-3;
 
 // Columns per tile side (visibility_grid.rs dispatches (N / VISIBILITY_TILE)^2 tiles).
 const int VISIBILITY_TILE = 32;
-
-uint level_offset(int k) {
-    uint n = uint(run.visibility_side);
-    uint m = n >> uint(k);
-    return (n * n * n - m * m * m) / 28u;
-}
 
 vec3 vertex_position(uint index) {
     uint v = uint(int(index) + draw.vertex_offset) * 8u;
@@ -70,15 +65,14 @@ bool touches(ivec3 cell, vec3 a, vec3 b, vec3 c) {
              || edge_separates(a - c, v0, v1, v2, h));
 }
 
-void set_cell(int k, ivec3 cell) {
-    int n = run.visibility_side >> k;
-    uint i = uint((cell.z * n + cell.y) * n + cell.x);
-    atomicOr(visibility_bits[level_offset(k) + (i >> 5u)], 1u << (i & 31u));
+void set_cell(ivec3 cell) {
+    uint i = grid_cell_index(0, cell);
+    atomicOr(visibility_bits[i >> 5u], 1u << (i & 31u));
 }
 
-// Marks the cells of level k (side n) the triangle a, b, c (in level-k cells) touches.
-void mark(int k, vec3 a, vec3 b, vec3 c) {
-    int n = run.visibility_side >> k;
+// Marks the finest cells the triangle a, b, c (in cells) touches.
+void mark(vec3 a, vec3 b, vec3 c) {
+    int n = run.visibility_side;
     vec3 lo = min(a, min(b, c)) - MARGIN, hi = max(a, max(b, c)) + MARGIN;
     if (any(lessThan(hi, vec3(0.0))) || any(greaterThanEqual(lo, vec3(float(n))))) return;
     ivec3 clo = clamp(ivec3(floor(lo)), ivec3(0), ivec3(n - 1));
@@ -113,7 +107,7 @@ void mark(int k, vec3 a, vec3 b, vec3 c) {
                 cell[ua] = cu;
                 cell[va] = cv;
                 cell[w] = cw;
-                if (touches(cell, a, b, c)) set_cell(k, cell);
+                if (touches(cell, a, b, c)) set_cell(cell);
             }
         }
     }
@@ -131,8 +125,5 @@ void main() {
     vec3 nrm = cross(b - a, c - a);
     // A triangle without area hides nothing (and has no plane).
     if (!(dot(nrm, nrm) > 1e-20)) return;
-    for (int k = 0; k < run.visibility_levels; ++k) {
-        float scale = 1.0 / float(1 << k);
-        mark(k, a * scale, b * scale, c * scale);
-    }
+    mark(a, b, c);
 }

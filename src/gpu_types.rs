@@ -116,6 +116,14 @@ pub struct VisibilityGridPush {
     pub triangles: u32,
 }
 
+/// `VisibilityGridLevelPush`: one dispatch of pass `visibility-grid`'s
+/// OR-levels, which reads level `level` and writes `level + 1`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct VisibilityGridLevelPush {
+    pub level: i32,
+}
+
 /// `RunUniforms::hisr_tau_mode` values, as in `shaders/shared.glsl`.
 pub const HISR_TAU_RELATIVE: i32 = 0;
 pub const HISR_TAU_ABSOLUTE: i32 = 1;

@@ -3,7 +3,7 @@
 
 use isr::gpu_types::{
     DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu,
-    RunUniforms, VisibilityGridPush,
+    RunUniforms, VisibilityGridLevelPush, VisibilityGridPush,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
@@ -213,6 +213,13 @@ fn visibility_grid_push_matches_shared_glsl() {
         instance => "instance",
         first_triangle => "first_triangle",
         triangles => "triangles",
+    ]);
+}
+
+#[test]
+fn visibility_grid_level_push_matches_shared_glsl() {
+    check!("visibility_grid_levels.comp", VisibilityGridLevelPush, "VisibilityGridLevelPush", level: 4, [
+        level => "level",
     ]);
 }
 

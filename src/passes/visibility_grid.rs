@@ -4,20 +4,23 @@
 //! which builds the voxel occupancy grid of this frame's posed scene.
 //!
 //! The grid is one storage buffer, set 0 binding 3 of every pipeline (the
-//! frame set, `frame::FrameSet`): `shaders/visibility_grid.comp` writes it,
+//! frame set, `frame::FrameSet`): `shaders/visibility_grid.comp` and
+//! `shaders/visibility_grid_levels.comp` write it,
 //! the patch formula (`patch_irradiance`, `shaders/vpl.glsl`) of every
 //! gathering method reads it through `shaders/visibility.glsl`. Nothing is
-//! kept across frames: the pass clears it and voxelizes every instance's
-//! triangles, posed by this frame's transforms, into the cube
-//! [`grid_cube`] puts around them.
+//! kept across frames: the pass clears it, voxelizes every instance's
+//! triangles, posed by this frame's transforms, into the finest level of the
+//! cube [`grid_cube`] puts around them, then makes each coarser level the OR
+//! of the one below it (`shaders/visibility_grid_levels.comp`).
 //!
 //! Barriers (in `record`): the previous frame's readers (shaders of every
 //! stage, the readback copy) before the clear; the clear before the
-//! voxelization's atomics; the atomics before every later reader.
+//! voxelization's atomics; the atomics before the first OR-level, each
+//! OR-level before the next; the last before every later reader.
 
 use super::INDIRECT_COMPUTE;
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::{self, RunUniforms, VisibilityGridPush};
+use crate::gpu_types::{self, RunUniforms, VisibilityGridLevelPush, VisibilityGridPush};
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::RenderSettings;
 use crate::vk::barrier;
@@ -226,17 +229,21 @@ const TRIANGLES_PER_DISPATCH: u32 = 64 * 65_535;
 /// Pass `visibility-grid`.
 pub struct VisibilityGridPass {
     pipeline: Pipeline,
+    /// The OR-levels (`visibility_grid_levels.comp`).
+    levels: Pipeline,
     set: DescriptorSet,
     /// The grid it clears and fills (bound in the frame set).
     buffer: vk::Buffer,
     bytes: u64,
     /// Tiles of `TILE` x `TILE` columns a triangle's invocations split it into.
     tiles: u32,
+    /// Finest cells per side.
+    side: u32,
 }
 
 /// Columns per tile side of the voxelization (`VISIBILITY_TILE` in
 /// `shaders/visibility_grid.comp`): one invocation covers one tile of one
-/// triangle at every level, within lavapipe's loop limit.
+/// triangle, within lavapipe's loop limit.
 pub const TILE: u32 = 32;
 
 impl VisibilityGridPass {
@@ -259,16 +266,28 @@ impl VisibilityGridPass {
             std::mem::size_of::<VisibilityGridPush>() as u32,
             &[],
         )?;
+        let levels = Pipeline::compute(
+            setup.gpu,
+            "visibility-grid levels",
+            "visibility_grid_levels.comp",
+            &[setup.frame],
+            std::mem::size_of::<VisibilityGridLevelPush>() as u32,
+            &[],
+        )?;
+        let side = GRID.get(setup.settings);
         Ok(Self {
             pipeline,
+            levels,
             set,
             buffer: grid.buffer,
             bytes: memory(setup.settings),
-            tiles: (GRID.get(setup.settings) / TILE).max(1).pow(2),
+            tiles: (side / TILE).max(1).pow(2),
+            side,
         })
     }
 
-    /// Clears the grid and voxelizes every instance into it.
+    /// Clears the grid, voxelizes every instance into its finest level and
+    /// makes the OR-levels.
     pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
@@ -312,6 +331,30 @@ impl VisibilityGridPass {
                     gpu.device.cmd_dispatch(cmd, n.div_ceil(64), self.tiles, 1);
                     first += n;
                 }
+            }
+            // Each OR-level reads the level below it whole: the
+            // voxelization's atomics, or the previous OR-level, come first.
+            self.levels
+                .bind(gpu, cmd, vk::PipelineBindPoint::COMPUTE, &[ctx.frame_set]);
+            for k in 0..levels(self.side) - 1 {
+                barrier::memory(
+                    gpu,
+                    cmd,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    rw,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    rw,
+                );
+                let push = VisibilityGridLevelPush { level: k as i32 };
+                gpu.device.cmd_push_constants(
+                    cmd,
+                    self.levels.layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+                let words = (self.side >> (k + 1)).pow(3) / 32;
+                gpu.device.cmd_dispatch(cmd, words.div_ceil(64), 1, 1);
             }
             // Every later reader: the patch formula in fragment shaders (and
             // any stage), the readback copy.
