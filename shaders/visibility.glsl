@@ -11,10 +11,7 @@
 
 layout(set = 0, binding = 3, std430) readonly buffer VisibilityGrid { uint visibility_bits[]; };
 
-bool grid_occupied(int k, ivec3 c) {
-    uint i = grid_cell_index(k, c);
-    return (visibility_bits[grid_level_offset(k) + (i >> 5u)] & (1u << (i & 31u))) != 0u;
-}
+bool grid_occupied(int k, ivec3 c) { return (visibility_bits[grid_word(k, c)] & grid_bit(k, c)) != 0u; }
 
 // The parts of the segment nearer than this to either end's tangent plane
 // (in finest cells) are not marched: the cells a plane touches lie within a

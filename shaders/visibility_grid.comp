@@ -65,10 +65,7 @@ bool touches(ivec3 cell, vec3 a, vec3 b, vec3 c) {
              || edge_separates(a - c, v0, v1, v2, h));
 }
 
-void set_cell(ivec3 cell) {
-    uint i = grid_cell_index(0, cell);
-    atomicOr(visibility_bits[i >> 5u], 1u << (i & 31u));
-}
+void set_cell(ivec3 cell) { atomicOr(visibility_bits[grid_word(0, cell)], grid_bit(0, cell)); }
 
 // Marks the finest cells the triangle a, b, c (in cells) touches.
 void mark(vec3 a, vec3 b, vec3 c) {

@@ -14,10 +14,7 @@ layout(local_size_x = 64) in;
 layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
 layout(push_constant) uniform Push { VisibilityGridLevelPush push; };
 
-bool occupied(int k, ivec3 c) {
-    uint i = grid_cell_index(k, c);
-    return (visibility_bits[grid_level_offset(k) + (i >> 5u)] & (1u << (i & 31u))) != 0u;
-}
+bool occupied(int k, ivec3 c) { return (visibility_bits[grid_word(k, c)] & grid_bit(k, c)) != 0u; }
 
 // The bits 0, 2, ..., 30 of x, packed into bits 0..15.
 uint even_bits(uint x) {
@@ -42,8 +39,7 @@ void main() {
         ivec3 c = ivec3(int(first % uint(n)), int((first / uint(n)) % uint(n)), int(first / uint(n * n)));
         uint lo = 0u, hi = 0u;
         for (int r = 0; r < 4; ++r) {
-            uint i = grid_cell_index(k, ivec3(2 * c.x, 2 * c.y + (r & 1), 2 * c.z + (r >> 1)));
-            uint at = grid_level_offset(k) + (i >> 5u);
+            uint at = grid_word(k, ivec3(2 * c.x, 2 * c.y + (r & 1), 2 * c.z + (r >> 1)));
             lo |= visibility_bits[at];
             hi |= visibility_bits[at + 1u];
         }

@@ -21,4 +21,8 @@ uint grid_cell_index(int k, ivec3 c) {
     return uint((c.z * n + c.y) * n + c.x);
 }
 
+// The word of the grid's buffer that holds cell c of level k, and its bit there.
+uint grid_word(int k, ivec3 c) { return grid_level_offset(k) + (grid_cell_index(k, c) >> 5u); }
+uint grid_bit(int k, ivec3 c) { return 1u << (grid_cell_index(k, c) & 31u); }
+
 #endif
