@@ -66,7 +66,8 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
     vec3 tin = min(ta, tb), tout = max(ta, tb);
     t0 = max(t0, max(tin.x, max(tin.y, tin.z)));
     t1 = min(t1, min(tout.x, min(tout.y, tout.z)));
-    vec3 ahead = vec3(greaterThan(ds, vec3(0.0)));
+    ivec3 ahead = ivec3(greaterThan(ds, vec3(0.0)));
+    vec3 a_inv = a * inv;          // a cell face f is left at t = f inv - a_inv
     float seg = length(d);         // the segment's length in cells
     float eps = 1e-3 / seg;        // a thousandth of a cell along the segment
     int top = run.visibility_levels - 1;
@@ -77,29 +78,36 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj) {
     ivec3 last_cell = ivec3(run.visibility_side - 1);
     float inside = 0.0;  // the segment's length inside occupied finest cells
     bool going = t < t1;
-    // One cell entered or one level changed.
+    // The finest cell at t: found once per advance, and kept while the march
+    // only changes level there.
+    ivec3 f = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);
+    // One cell entered or one level changed. The cell at t was entered at t
+    // (less the thousandth of a cell the last advance stepped past its face,
+    // or at t0), so an occupied cell's chord runs from t to where the march
+    // leaves it. Level k + 1's cell changes where f's bits above k do.
+    // The step has no branches: every lane computes both outcomes and keeps
+    // its own by selects. On lavapipe the branched step (a descent or an
+    // advance, inside `if (going)`) took HISR's indirect time with the grid
+    // to 1.1-1.2x this one's (docs/algorithm.md section 5, "Voxel
+    // visibility"); the grid's words are read for every lane alike.
 #define VISIBILITY_STEP                                                              \
-    if (going) {                                                                     \
-        ivec3 f = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);               \
-        ivec3 c = ivec3(f.x >> k, f.y >> k, f.z >> k);                               \
+    {                                                                                \
+        ivec3 c = f >> k;                                                            \
         bool occupied = grid_occupied(k, c);                                         \
-        if (occupied && k > 0) {                                                     \
-            k -= 1;                                                                  \
-        } else {                                                                     \
-            vec3 far = ((vec3(c) + ahead) * float(1 << k) - a) * inv;                \
-            float leave = min(far.x, min(far.y, far.z));                             \
-            if (occupied) {                                                          \
-                vec3 near = (vec3(c) + (1.0 - ahead) - a) * inv;                     \
-                float enter = max(t0, max(near.x, max(near.y, near.z)));             \
-                float chord = (min(leave, t1) - enter) * seg;                        \
-                inside += chord;                                                     \
-            }                                                                        \
-            t = max(t, leave) + eps;                                                 \
-            going = t < t1 && inside < VISIBILITY_OPAQUE_CHORD;                      \
-            ivec3 n = clamp(ivec3(floor(a + t * d)), ivec3(0), last_cell);           \
-            int up = k + 1;                                                          \
-            if (k < top && ivec3(n.x >> up, n.y >> up, n.z >> up) != c / 2) k = up;  \
-        }                                                                            \
+        bool down = occupied && k > 0;                                               \
+        vec3 far = vec3((c + ahead) << k) * inv - a_inv;                             \
+        float leave = min(far.x, min(far.y, far.z));                                 \
+        bool advance = going && !down;                                               \
+        float chord = (min(leave, t1) - t) * seg;                                    \
+        inside += (advance && occupied) ? chord : 0.0;                               \
+        float tn = max(t, leave) + eps;                                              \
+        ivec3 next = clamp(ivec3(floor(a + tn * d)), ivec3(0), last_cell);           \
+        ivec3 moved = (next ^ f) >> (k + 1);                                         \
+        bool up = k < top && (moved.x | moved.y | moved.z) != 0;                     \
+        k = (going && down) ? k - 1 : ((advance && up) ? k + 1 : k);                 \
+        t = advance ? tn : t;                                                        \
+        f = advance ? next : f;                                                      \
+        going = going && (down || (tn < t1 && inside < VISIBILITY_OPAQUE_CHORD));    \
     }
     for (int i = 0; i < VISIBILITY_MAX_ITERATIONS && going; ++i) {
         VISIBILITY_STEP

@@ -15,10 +15,11 @@ uint grid_level_offset(int k) {
     return (n * n * n - m * m * m) / 28u;
 }
 
-// Cell c's index within level k (side N >> k).
+// Cell c's index within level k (side N >> k, a power of 2: shifts, not
+// multiplies, which the march does at every step).
 uint grid_cell_index(int k, ivec3 c) {
-    int n = run.visibility_side >> k;
-    return uint((c.z * n + c.y) * n + c.x);
+    int s = findMSB(run.visibility_side) - k;
+    return uint(c.x | (c.y << s) | (c.z << (2 * s)));
 }
 
 // The word of the grid's buffer that holds cell c of level k, and its bit there.
