@@ -162,7 +162,7 @@ void main() {
         for (int k = 0; k < 4; ++k) {
             // A corner without geometry is never used (the gather gives it no weight).
             if (corner[k].w > 0.0) {
-                v[k] = voxel_visibility(corner[k].xyz, corner_normal[k], lp.position_area.xyz, lp.normal.xyz);
+                v[k] = voxel_visibility(corner[k].xyz, corner_normal[k], lp.position_area.xyz, lp.normal.xyz, lp.position_area.w);
                 widen_spread(lo, hi, v[k]);
             }
         }
@@ -171,7 +171,7 @@ void main() {
         if (points > 0) {
             vec4 w = vec4(1.0);
             for (int k = 0; k < points; ++k) {
-                w[k] = voxel_visibility(point[k].xyz, point_normal[k], lp.position_area.xyz, lp.normal.xyz);
+                w[k] = voxel_visibility(point[k].xyz, point_normal[k], lp.position_area.xyz, lp.normal.xyz, lp.position_area.w);
             }
             cut[header.points.y + t * header.visibility.y + slot] = packUnorm4x8(w);
             // The receivers that take the points march where the corners

@@ -65,11 +65,20 @@ bool touches(ivec3 cell, vec3 a, vec3 b, vec3 c) {
              || edge_separates(a - c, v0, v1, v2, h));
 }
 
-void set_cell(ivec3 cell) { atomicOr(visibility_bits[grid_word(0, cell)], grid_bit(0, cell)); }
+// Sets sub-cell s's bit (in sub-cells of the whole grid) in its finest
+// cell's mask, or without sub-cells the finest cell s's bit.
+void set_sub_cell(ivec3 s) {
+    if (GRID_SUB == 1) {
+        atomicOr(visibility_bits[grid_word(0, s)], grid_bit(0, s));
+        return;
+    }
+    uint b = grid_sub_bit(s & (GRID_SUB - 1));
+    atomicOr(visibility_bits[grid_mask_word(s / GRID_SUB) + (b >> 5u)], 1u << (b & 31u));
+}
 
-// Marks the finest cells the triangle a, b, c (in cells) touches.
+// Marks the sub-cells the triangle a, b, c (in sub-cells) touches.
 void mark(vec3 a, vec3 b, vec3 c) {
-    int n = run.visibility_side;
+    int n = run.visibility_side * GRID_SUB;
     vec3 lo = min(a, min(b, c)) - MARGIN, hi = max(a, max(b, c)) + MARGIN;
     if (any(lessThan(hi, vec3(0.0))) || any(greaterThanEqual(lo, vec3(float(n))))) return;
     ivec3 clo = clamp(ivec3(floor(lo)), ivec3(0), ivec3(n - 1));
@@ -104,7 +113,7 @@ void mark(vec3 a, vec3 b, vec3 c) {
                 cell[ua] = cu;
                 cell[va] = cv;
                 cell[w] = cw;
-                if (touches(cell, a, b, c)) set_cell(cell);
+                if (touches(cell, a, b, c)) set_sub_cell(cell);
             }
         }
     }
@@ -116,9 +125,10 @@ void main() {
     uint first = draw.first_index + 3u * (draw.first_triangle + t);
     mat4 m = transforms[draw.instance].world_from_object;
     vec4 g = u.visibility_grid;
-    vec3 a = ((m * vec4(vertex_position(index_data[first]), 1.0)).xyz - g.xyz) / g.w;
-    vec3 b = ((m * vec4(vertex_position(index_data[first + 1u]), 1.0)).xyz - g.xyz) / g.w;
-    vec3 c = ((m * vec4(vertex_position(index_data[first + 2u]), 1.0)).xyz - g.xyz) / g.w;
+    float per = float(GRID_SUB) / g.w;  // sub-cells per unit of length
+    vec3 a = ((m * vec4(vertex_position(index_data[first]), 1.0)).xyz - g.xyz) * per;
+    vec3 b = ((m * vec4(vertex_position(index_data[first + 1u]), 1.0)).xyz - g.xyz) * per;
+    vec3 c = ((m * vec4(vertex_position(index_data[first + 2u]), 1.0)).xyz - g.xyz) * per;
     vec3 nrm = cross(b - a, c - a);
     // A triangle without area hides nothing (and has no plane).
     if (!(dot(nrm, nrm) > 1e-20)) return;

@@ -14,7 +14,13 @@ layout(local_size_x = 64) in;
 layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
 layout(push_constant) uniform Push { VisibilityGridLevelPush push; };
 
-bool occupied(int k, ivec3 c) { return (visibility_bits[grid_word(k, c)] & grid_bit(k, c)) != 0u; }
+bool occupied(int k, ivec3 c) {
+    if (k == 0 && GRID_SUB > 1) {
+        uint w = grid_mask_word(c);
+        return (visibility_bits[w] | visibility_bits[w + 1u]) != 0u;
+    }
+    return (visibility_bits[grid_word(k, c)] & grid_bit(k, c)) != 0u;
+}
 
 // The bits 0, 2, ..., 30 of x, packed into bits 0..15.
 uint even_bits(uint x) {
@@ -33,7 +39,7 @@ void main() {
     if (word >= cells / 32u) return;
     uint first = word * 32u;
     uint bits = 0u;
-    if (n >= 32) {
+    if (n >= 32 && (k > 0 || GRID_SUB == 1)) {
         // The word is 32 cells of one row; their children are 64 cells of
         // each of four rows of level k, two whole words each.
         ivec3 c = ivec3(int(first % uint(n)), int((first / uint(n)) % uint(n)), int(first / uint(n * n)));
@@ -46,7 +52,8 @@ void main() {
         // Neighbouring children along x are neighbouring bits.
         bits = even_bits(lo | (lo >> 1u)) | (even_bits(hi | (hi >> 1u)) << 16u);
     } else {
-        // Coarse levels (up to 16^3 cells): a word holds several rows.
+        // Level 1 from level 0's sub-cell masks, and coarse levels (up to
+        // 16^3 cells), where a word holds several rows.
         for (uint b = 0u; b < 32u; ++b) {
             uint i = first + b;
             ivec3 c = ivec3(int(i % uint(n)), int((i / uint(n)) % uint(n)), int(i / uint(n * n)));

@@ -46,7 +46,7 @@ vec3 patch_unshadowed(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int
 
 vec3 patch_irradiance(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
     vec3 e = patch_unshadowed(xi, ni, xj, nj, phi, a, level);
-    if (VOXEL_VISIBILITY) e *= voxel_visibility(xi, ni, xj, nj);
+    if (VOXEL_VISIBILITY) e *= voxel_visibility(xi, ni, xj, nj, a);
     return e;
 }
 

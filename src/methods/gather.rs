@@ -58,6 +58,7 @@ impl GatherPass {
             .filter(|_| source == LightPatches::TiledTraversal);
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let stencil = crate::multires::STENCIL.get(setup.settings);
+        let visibility = crate::passes::visibility_grid::specialization(setup.settings);
         let pipeline = PassPipeline::graphics(
             gpu,
             setup.frame,
@@ -85,7 +86,8 @@ impl GatherPass {
                     (0, source as i32),
                     (1, shared.is_some() as i32),
                     (2, shared.unwrap_or(1.0).to_bits() as i32),
-                    crate::passes::visibility_grid::specialization(setup.settings),
+                    visibility[0],
+                    visibility[1],
                 ],
                 ..Default::default()
             },

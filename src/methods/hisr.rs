@@ -440,8 +440,12 @@ impl CutPass {
                     Binding::storage("HisrCut", &buffer),
                 ]],
                 0,
-                // REFINE_SPREAD: which entries get their march bit.
-                &[(0, SHARED_REFINE.get(setup.settings).to_bits() as i32)],
+                // REFINE_SPREAD: which entries get their march bit; the
+                // grid's layout and march.
+                &[
+                    (0, SHARED_REFINE.get(setup.settings).to_bits() as i32),
+                    crate::passes::visibility_grid::specialization(setup.settings)[1],
+                ],
             )?),
             false => None,
         };

@@ -104,7 +104,7 @@ impl Reference {
                 push_constant_bytes: 8,
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &[crate::passes::visibility_grid::specialization(s)],
+                specialization: &crate::passes::visibility_grid::specialization(s),
                 ..Default::default()
             },
         )?;

@@ -107,6 +107,7 @@ impl RsmSplat {
     /// `restricted`: quads bounded by `--splat-threshold` (else full screen).
     pub fn new(setup: &Setup, restricted: bool) -> Result<Self> {
         let format = setup.targets.indirect.format;
+        let visibility = crate::passes::visibility_grid::specialization(setup.settings);
         require_blending(setup.gpu, format, "rsm-splat")?;
         let pipeline = PassPipeline::graphics(
             setup.gpu,
@@ -118,10 +119,7 @@ impl RsmSplat {
                 fragment_shader: "vpl_splat.frag",
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &[
-                    (0, restricted as i32),
-                    crate::passes::visibility_grid::specialization(setup.settings),
-                ],
+                specialization: &[(0, restricted as i32), visibility[0], visibility[1]],
                 ..Default::default()
             },
         )?;

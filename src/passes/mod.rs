@@ -334,7 +334,7 @@ impl FullscreenPass {
                 fragment_shader,
                 push_constant_bytes,
                 color_formats: &[output(setup.targets).format],
-                specialization: &[visibility_grid::specialization(setup.settings)],
+                specialization: &visibility_grid::specialization(setup.settings),
                 ..Default::default()
             },
         )?;

@@ -86,7 +86,18 @@ pub const GRID: Param<u32> = Param {
     range: Range::powers_of(2, 16.0, 1024.0),
 };
 
-pub const PARAMS: &[&dyn AnyParam] = &[&VISIBILITY, &GRID];
+/// Sub-cells per side of a finest cell.
+pub const SUBCELLS: Param<u32> = Param {
+    name: "visibility-subcells",
+    help: "--visibility voxels: sub-cells per side of each finest cell of the grid (1, 2 or \
+           4): occupancy kept at that finer scale, so thin occluders cast shadows no wider \
+           than they are and the march starts nearer the receiver; 1 is the plain grid \
+           (faster, 1 bit a cell against 8 bytes)",
+    default: DefaultValue::Fixed(4),
+    range: Range::powers_of(2, 1.0, 4.0),
+};
+
+pub const PARAMS: &[&dyn AnyParam] = &[&VISIBILITY, &GRID, &SUBCELLS];
 
 /// The coarsest level has 4 x 4 x 4 cells (whole 32-bit words, and coarser
 /// levels would be occupied almost always).
@@ -106,34 +117,53 @@ pub fn uses_voxels(s: &RenderSettings) -> bool {
 /// (`grid_used`: whether one does), which is most likely a forgotten
 /// `--visibility voxels`.
 pub fn unused_grid_warning(s: &RenderSettings, grid_used: bool) -> Option<String> {
-    (GRID.is_set_in(s) && !grid_used).then(|| {
+    let set: Vec<String> = [
+        (&GRID, "visibility-grid"),
+        (&SUBCELLS, "visibility-subcells"),
+    ]
+    .into_iter()
+    .filter(|(p, _)| p.is_set_in(s))
+    .map(|(p, name)| format!("--{name} {}", p.get(s)))
+    .collect();
+    (!set.is_empty() && !grid_used).then(|| {
         format!(
-            "warning: --visibility-grid {} has no effect without --visibility voxels",
-            GRID.get(s)
+            "warning: {} has no effect without --visibility voxels",
+            set.join(" and ")
         )
     })
 }
 
-/// The specialization constant `VOXEL_VISIBILITY` (`shaders/vpl.glsl`) of
-/// every pipeline that evaluates the patch formula: the march is compiled
-/// only into runs with the grid (a uniform branch around it slowed every
-/// gather on lavapipe). Shaders without the constant ignore the entry.
-pub fn specialization(s: &RenderSettings) -> (u32, i32) {
-    (10, uses_voxels(s) as i32)
+/// The specialization constants of every pipeline that evaluates the patch
+/// formula, marches the grid or builds it: `VOXEL_VISIBILITY`
+/// (`shaders/vpl.glsl`; the march is compiled only into runs with the grid,
+/// as a uniform branch around it slowed every gather on lavapipe) and
+/// `GRID_SUB` (`shaders/visibility_layout.glsl`; the layout and the march's
+/// sub-cell samples). Shaders without a constant ignore its entry.
+pub fn specialization(s: &RenderSettings) -> [(u32, i32); 2] {
+    [(10, uses_voxels(s) as i32), (11, SUBCELLS.get(s) as i32)]
 }
 
-/// Bytes of the grid of `s`: one bit per cell of every level (0 without
-/// `--visibility voxels`).
+/// Bytes of the grid of `s` (0 without `--visibility voxels`).
 pub fn memory(s: &RenderSettings) -> u64 {
     match uses_voxels(s) {
-        true => grid_bytes(GRID.get(s)),
+        true => grid_bytes(GRID.get(s), SUBCELLS.get(s)),
         false => 0,
     }
 }
 
-/// Bytes of a grid of side `n` with its OR-levels: about n^3 / 8 * 8 / 7.
-pub fn grid_bytes(n: u32) -> u64 {
-    (0..levels(n)).map(|k| (n as u64 >> k).pow(3) / 8).sum()
+/// Bytes of a grid of side `n` with `sub` sub-cells per side of a finest
+/// cell (`shaders/visibility_layout.glsl`): a bit per cell of every OR-level,
+/// about n^3 / 56 bytes, and a bit (`sub` 1) or a 64-bit mask of its
+/// sub-cells (2, 4) per finest cell.
+pub fn grid_bytes(n: u32, sub: u32) -> u64 {
+    let finest = match sub {
+        1 => (n as u64).pow(3) / 8,
+        _ => 8 * (n as u64).pow(3),
+    };
+    finest
+        + (1..levels(n))
+            .map(|k| (n as u64 >> k).pow(3) / 8)
+            .sum::<u64>()
 }
 
 /// Checks for a method that reads the visibility: `exact` is the CPU limit
@@ -149,18 +179,20 @@ pub fn check(s: &RenderSettings, method: &str, reads_exact: bool) -> Result<()> 
 }
 
 /// Checks, before anything is allocated, that the grid of `s` fits the one
-/// storage buffer `gpu` binds it as: at 1024 it takes 147 MiB, past the
-/// 128 MiB that some devices (lavapipe among them) bind at once.
+/// storage buffer `gpu` binds it as: with 4 sub-cells at 256 it takes 129
+/// MiB (without, at 1024, 147 MiB), past the 128 MiB that some devices
+/// (lavapipe among them) bind at once.
 pub fn check_device(gpu: &Gpu, s: &RenderSettings) -> Result<()> {
     let (bytes, range) = (memory(s), gpu.limits().max_storage_buffer_range as u64);
     if bytes > range {
-        let mut fits = GRID.get(s);
-        while fits > 16 && grid_bytes(fits) > range {
+        let (mut fits, sub) = (GRID.get(s), SUBCELLS.get(s));
+        while fits > 16 && grid_bytes(fits, sub) > range {
             fits /= 2;
         }
         bail!(
-            "--visibility-grid {}: the grid takes {} MiB, more than {} binds in one buffer \
-             (maxStorageBufferRange: {} MiB); choose --visibility-grid {fits} or less",
+            "--visibility-grid {} --visibility-subcells {sub}: the grid takes {} MiB, more \
+             than {} binds in one buffer (maxStorageBufferRange: {} MiB); choose \
+             --visibility-grid {fits} or less",
             GRID.get(s),
             bytes.div_ceil(1 << 20),
             gpu.info.name,
@@ -184,16 +216,23 @@ pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
 
 /// The grid's cube for a posed scene whose instances have the world boxes
 /// `boxes`: centred on their union, its side the union's largest extent and
-/// one and a half cells more on each side, `n` cells per side. Surfaces on
-/// the bounds then lie inside cells, along the largest extent in their
-/// middle: a plane on a face between two cells would make both occupied.
-/// xyz: its min corner; w: a cell's side.
-pub fn grid_cube(boxes: impl Iterator<Item = (Vec3, Vec3)>, n: u32) -> [f32; 4] {
+/// a margin of one and a half cells more on each side, `n` cells per side.
+/// Surfaces on the bounds then lie inside cells, along the largest extent in
+/// their middle: a plane on a face between two cells would make both
+/// occupied. With `sub` sub-cells (2, 4) the middle of a cell is a face
+/// between sub-cells, so the margin is half a sub-cell more, which puts those
+/// surfaces in the middle of a sub-cell instead (one layer of sub-cells, not
+/// two). xyz: its min corner; w: a cell's side.
+pub fn grid_cube(boxes: impl Iterator<Item = (Vec3, Vec3)>, n: u32, sub: u32) -> [f32; 4] {
     let (lo, hi) = boxes
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
         .unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let extent = (hi - lo).max_element().max(1e-6);
-    let cell = extent / (n as f32 - 3.0);
+    let margin = match sub {
+        1 => 1.5,
+        _ => 1.5 + 0.5 / sub as f32,
+    };
+    let cell = extent / (n as f32 - 2.0 * margin);
     let side = cell * n as f32;
     let corner = (lo + hi) * 0.5 - Vec3::splat(side * 0.5);
     [corner.x, corner.y, corner.z, cell]
@@ -235,7 +274,8 @@ pub struct VisibilityGridPass {
     /// The grid it clears and fills (bound in the frame set).
     buffer: vk::Buffer,
     bytes: u64,
-    /// Tiles of `TILE` x `TILE` columns a triangle's invocations split it into.
+    /// Tiles of `TILE` x `TILE` columns (of sub-cells) a triangle's
+    /// invocations split it into.
     tiles: u32,
     /// Finest cells per side.
     side: u32,
@@ -264,7 +304,7 @@ impl VisibilityGridPass {
             "visibility_grid.comp",
             &[setup.frame, &set],
             std::mem::size_of::<VisibilityGridPush>() as u32,
-            &[],
+            &specialization(setup.settings),
         )?;
         let levels = Pipeline::compute(
             setup.gpu,
@@ -272,16 +312,16 @@ impl VisibilityGridPass {
             "visibility_grid_levels.comp",
             &[setup.frame],
             std::mem::size_of::<VisibilityGridLevelPush>() as u32,
-            &[],
+            &specialization(setup.settings),
         )?;
-        let side = GRID.get(setup.settings);
+        let (side, sub) = (GRID.get(setup.settings), SUBCELLS.get(setup.settings));
         Ok(Self {
             pipeline,
             levels,
             set,
             buffer: grid.buffer,
             bytes: memory(setup.settings),
-            tiles: (side / TILE).max(1).pow(2),
+            tiles: (side * sub / TILE).max(1).pow(2),
             side,
         })
     }
@@ -379,7 +419,10 @@ mod tests {
         assert_eq!(levels(16), 3);
         assert_eq!(levels(64), 5);
         // 64^3 / 8 + 32^3 / 8 + 16^3 / 8 + 8^3 / 8 + 4^3 / 8 bytes.
-        assert_eq!(grid_bytes(64), 32768 + 4096 + 512 + 64 + 8);
+        assert_eq!(grid_bytes(64, 1), 32768 + 4096 + 512 + 64 + 8);
+        // With sub-cells, 8 bytes per finest cell.
+        assert_eq!(grid_bytes(64, 4), 8 * 262_144 + 4096 + 512 + 64 + 8);
+        assert_eq!(grid_bytes(64, 2), grid_bytes(64, 4));
         // The shader's offset formula: words before level k are (n^3 - m^3) / 28.
         for n in [16u64, 64, 1024] {
             let mut words = 0;
@@ -388,7 +431,22 @@ mod tests {
                 assert_eq!(words, (n * n * n - m * m * m) / 28, "{n} {k}");
                 words += m * m * m / 32;
             }
-            assert_eq!(words * 4, grid_bytes(n as u32));
+            assert_eq!(words * 4, grid_bytes(n as u32, 1));
+            // With sub-cells: level 0's masks, 2 n^3 words, then the same
+            // levels of bits from level 1: before level k, 2 n^3 +
+            // ((n / 2)^3 - m^3) / 28, every level at an even word.
+            let (h, mut words) = (n / 2, 2 * n * n * n);
+            for k in 1..levels(n as u32) {
+                let m = n >> k;
+                assert_eq!(
+                    words,
+                    2 * n * n * n + (h * h * h - m * m * m) / 28,
+                    "{n} {k}"
+                );
+                assert_eq!(words % 2, 0);
+                words += m * m * m / 32;
+            }
+            assert_eq!(words * 4, grid_bytes(n as u32, 4));
         }
     }
 
@@ -398,11 +456,17 @@ mod tests {
             (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 1.0)),
             (Vec3::new(-1.0, 0.5, 0.0), Vec3::new(0.0, 1.0, 3.0)),
         ];
-        let [x, y, z, cell] = grid_cube(boxes.into_iter(), 64);
+        let [x, y, z, cell] = grid_cube(boxes.into_iter(), 64, 1);
         let lo = Vec3::new(x, y, z);
         let hi = lo + Vec3::splat(cell * 64.0);
         assert!((cell - 3.0 / 61.0).abs() < 1e-6);
         assert!(lo.cmple(Vec3::new(-1.0, 0.0, 0.0) - cell * 1.49).all());
         assert!(hi.cmpge(Vec3::new(1.0, 2.0, 3.0) + cell * 1.49).all());
+        // With 4 sub-cells the bounds of the largest extent (z, 3 long) lie
+        // in the middle of a sub-cell: 1.625 cells, 6.5 sub-cells, in.
+        let [_, _, z, cell] = grid_cube(boxes.into_iter(), 64, 4);
+        assert!((cell - 3.0 / 60.75).abs() < 1e-6);
+        let inside = |p: f32| (p - z) / cell * 4.0;
+        assert!((inside(0.0) - 6.5).abs() < 1e-3 && (inside(3.0) - (256.0 - 6.5)).abs() < 1e-3);
     }
 }

@@ -279,7 +279,11 @@ impl<'g> Renderer<'g> {
             .iter()
             .zip(&self.state.instance_transforms)
             .map(|(b, m)| crate::view::transformed_box(m, *b));
-        visibility_grid::grid_cube(boxes, visibility_grid::GRID.get(&self.settings))
+        visibility_grid::grid_cube(
+            boxes,
+            visibility_grid::GRID.get(&self.settings),
+            visibility_grid::SUBCELLS.get(&self.settings),
+        )
     }
 
     /// The voxel visibility grid's buffer (its bits, `shaders/visibility.glsl`).

@@ -577,6 +577,13 @@ pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
     s
 }
 
+/// `s` with the plain grid: one bit per finest cell, no sub-cells
+/// (`--visibility-subcells 1`).
+pub fn plain_grid(mut s: RenderSettings) -> RenderSettings {
+    isr::passes::visibility_grid::SUBCELLS.set(&mut s, 1);
+    s
+}
+
 /// `s` with HISR marching from every receiver (`--hisr-shared-visibility
 /// off`; the default shares the tiles' visibility).
 pub fn per_receiver(mut s: RenderSettings) -> RenderSettings {
