@@ -341,21 +341,21 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
     let hisr = isr::bench::sweep::sweep(isr::methods::hisr::KEY, 32, true).len();
     let lpv = isr::bench::sweep::sweep(isr::methods::lpv::KEY, 32, true).len();
     assert_eq!(of("hisr", "none").len(), hisr);
-    assert_eq!(of("hisr", "voxels 64").len(), hisr);
+    assert_eq!(of("hisr", "voxels 64 sub 4").len(), hisr);
     assert_eq!(of("lpv", "none").len(), lpv);
-    assert!(of("lpv", "voxels 64").is_empty());
+    assert!(of("lpv", "voxels 64 sub 4").is_empty());
     assert_eq!(rows.len(), 2 + 2 * hisr + lpv);
     // Rows without visibility keep the keys of runs before the axis.
     for r in &rows {
         let key = r["key"].as_str().unwrap();
         assert_eq!(
-            key.ends_with("|voxels 64"),
-            r["visibility"] == "voxels 64",
+            key.ends_with("|voxels 64 sub 4"),
+            r["visibility"] == "voxels 64 sub 4",
             "{key}"
         );
     }
     let truth = |r: &serde_json::Value| r["truth"]["rel_rmse_indirect"].as_f64().unwrap();
-    let (without, with) = (of("reference", "none"), of("reference", "voxels 64"));
+    let (without, with) = (of("reference", "none"), of("reference", "voxels 64 sub 4"));
     println!(
         "reference against the truth: {:.4} without, {:.4} with the grid",
         truth(without[0]),
@@ -367,7 +367,10 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
         truth(without[0]),
         truth(with[0])
     );
-    for (a, b) in of("hisr", "none").into_iter().zip(of("hisr", "voxels 64")) {
+    for (a, b) in of("hisr", "none")
+        .into_iter()
+        .zip(of("hisr", "voxels 64 sub 4"))
+    {
         assert_eq!(a["label"], b["label"]);
         let (ta, tb) = (truth(a), truth(b));
         println!(
@@ -384,7 +387,7 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
     }
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     assert!(csv.starts_with("scene,method,visibility,label,"), "{csv}");
-    assert!(csv.contains("\ncornell,hisr,voxels 64,"), "{csv}");
+    assert!(csv.contains("\ncornell,hisr,voxels 64 sub 4,"), "{csv}");
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(report.contains("## Indirect visibility: none against voxels 64"));
     assert!(report.contains("| cornell | hisr | tau "), "{report}");

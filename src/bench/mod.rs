@@ -314,9 +314,8 @@ impl Plan {
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         // With the voxel grid on (`--visibility voxels`), rows are kept
         // apart from a run's without it, so both can share a directory.
-        use crate::passes::visibility_grid::{uses_voxels, GRID};
-        let visibility = match uses_voxels(b) {
-            true => format!("|voxels {}", GRID.get(b)),
+        let visibility = match crate::passes::visibility_grid::uses_voxels(b) {
+            true => format!("|{}", visibility::label(b)),
             false => String::new(),
         };
         format!(

@@ -9,7 +9,7 @@
 
 use super::rows::Row;
 use super::Plan;
-use crate::passes::visibility_grid::{Visibility, GRID, VISIBILITY};
+use crate::passes::visibility_grid::{Visibility, GRID, SUBCELLS, VISIBILITY};
 use crate::settings::{Method, RenderSettings};
 use anyhow::{bail, Result};
 
@@ -83,11 +83,16 @@ pub fn reads(method: Method) -> bool {
 }
 
 /// The visibility of rows rendered with `s`, as rows and tables show it:
-/// `none`, or `voxels N` with the grid's side.
+/// `none`, or `voxels N sub S` with the grid's side and sub-cells (`voxels
+/// N` for the plain grid, as rows were labelled before there were
+/// sub-cells, so that a journal's older rows keep what they measured).
 pub fn label(s: &RenderSettings) -> String {
     match VISIBILITY.get(s) {
         Visibility::None => "none".into(),
-        Visibility::Voxels => format!("voxels {}", GRID.get(s)),
+        Visibility::Voxels => match SUBCELLS.get(s) {
+            1 => format!("voxels {}", GRID.get(s)),
+            sub => format!("voxels {} sub {sub}", GRID.get(s)),
+        },
         Visibility::Exact => "exact".into(),
     }
 }
