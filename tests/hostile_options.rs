@@ -259,7 +259,7 @@ fn warns_only_without_voxels(name: &str, alone: &[&str], warning: &str) {
         .args(alone)
         .args(["--visibility", "voxels"])
         .succeeds();
-    assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
+    assert!(!ran.stderr.contains("no effect"), "{}", ran.stderr);
 }
 
 /// `--visibility-grid` without `--visibility voxels` is most likely a
@@ -271,6 +271,21 @@ fn a_grid_without_voxel_visibility_is_named_as_having_no_effect() {
         "grid-without-voxels",
         &["--method", "hisr", "--visibility-grid", "32"],
         "--visibility-grid 32 has no effect without --visibility voxels",
+    );
+}
+
+/// The same for `--visibility-subcells`, alone and with the grid's size.
+#[test]
+fn subcells_without_voxel_visibility_are_named_as_having_no_effect() {
+    warns_only_without_voxels(
+        "subcells-without-voxels",
+        &["--method", "hisr", "--visibility-subcells", "1"],
+        "--visibility-subcells 1 has no effect without --visibility voxels",
+    );
+    warns_only_without_voxels(
+        "grid-and-subcells-without-voxels",
+        &["--method", "hisr", "--visibility-grid", "32", "--visibility-subcells", "2"],
+        "--visibility-grid 32 and --visibility-subcells 2 have no effect without --visibility voxels",
     );
 }
 

@@ -126,8 +126,9 @@ pub fn unused_grid_warning(s: &RenderSettings, grid_used: bool) -> Option<String
     .map(|(p, name)| format!("--{name} {}", p.get(s)))
     .collect();
     (!set.is_empty() && !grid_used).then(|| {
+        let verb = if set.len() == 1 { "has" } else { "have" };
         format!(
-            "warning: {} has no effect without --visibility voxels",
+            "warning: {} {verb} no effect without --visibility voxels",
             set.join(" and ")
         )
     })
