@@ -258,12 +258,16 @@ mod tests {
         assert_eq!(names(&passes[0]), ["hisr", "lpv"]);
         assert_eq!(passes[0].visibility_label(), "none");
         assert_eq!(names(&passes[1]), ["hisr"]);
-        assert_eq!(passes[1].visibility_label(), "voxels 64");
+        assert_eq!(passes[1].visibility_label(), "voxels 64 sub 4");
         // `none` rows' keys are those of a run before the axis; the grid's
         // carry it, as `--visibility voxels` runs' did.
         let key = |q: &Plan| q.key("cornell", "hisr", "tau 0.2, depth 7");
         assert_eq!(key(&passes[0]), key(&p));
-        assert!(key(&passes[1]).ends_with("|voxels 64"));
+        assert!(key(&passes[1]).ends_with("|voxels 64 sub 4"));
+        // The plain grid keeps the label (and key) it had before sub-cells.
+        let mut plain = passes[1].base.clone();
+        SUBCELLS.set(&mut plain, 1);
+        assert_eq!(label(&plain), "voxels 64");
         // Without `none` in the list, the methods that read no visibility
         // still render once without it, beside the model error's reference.
         let p = plan(&["voxels"], &["hisr", "lpv"]).unwrap();
