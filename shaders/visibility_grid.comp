@@ -17,10 +17,14 @@
 // axes edge x box-axis are tested per cell.
 //
 // Lavapipe ends a shader invocation's loops after 65,535 iterations
-// together, so one invocation covers one tile of VISIBILITY_TILE x
-// VISIBILITY_TILE columns (gl_GlobalInvocationID.y; a grid no wider than a
-// tile is covered by tile 0 alone): at most 3 cells per column, since the
-// columns run along the normal's dominant axis.
+// together, so a triangle's columns are split into tiles of VISIBILITY_TILE
+// x VISIBILITY_TILE (at most 3 cells per column, since the columns run along
+// the normal's dominant axis: about 4,200 iterations a tile), and the
+// dispatch's y invocations of a triangle take every y-th of its own tiles:
+// visibility_grid.rs makes y large enough that none takes more than 8. (One
+// invocation per tile of the whole grid instead, most of them returning at
+// once, took the pass on the conference room from 37 ms to 382 with 4
+// sub-cells.)
 #extension GL_GOOGLE_include_directive : require
 #include "visibility_layout.glsl"
 layout(local_size_x = 64) in;
@@ -34,7 +38,7 @@ layout(push_constant) uniform Push { VisibilityGridPush draw; };
 // In cells: covers float error in the corners and faces the tests compare.
 const float MARGIN = 1e-3;
 
-// Columns per tile side (visibility_grid.rs dispatches (N / VISIBILITY_TILE)^2 tiles).
+// Columns per tile side (visibility_grid.rs: TILE).
 const int VISIBILITY_TILE = 32;
 
 vec3 vertex_position(uint index) {
@@ -89,31 +93,33 @@ void mark(vec3 a, vec3 b, vec3 c) {
     // w = (dp - nrm_u u - nrm_v v) / nrm_w.
     int w = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
     int ua = (w + 1) % 3, va = (w + 2) % 3;
-    // This invocation's tile of (u, v) columns.
-    int tiles = max(n / VISIBILITY_TILE, 1);
-    int tile = int(gl_GlobalInvocationID.y);
-    if (tile >= tiles * tiles) return;
-    ivec2 t0 = ivec2(tile % tiles, tile / tiles) * VISIBILITY_TILE;
-    clo[ua] = max(clo[ua], t0.x);
-    clo[va] = max(clo[va], t0.y);
-    chi[ua] = min(chi[ua], t0.x + VISIBILITY_TILE - 1);
-    chi[va] = min(chi[va], t0.y + VISIBILITY_TILE - 1);
+    // The triangle's own (u, v) columns, in tiles of VISIBILITY_TILE^2;
+    // this invocation takes every tiles-th of them from its own
+    // (gl_GlobalInvocationID.y of the dispatch's y = tiles).
+    int tiles_u = (chi[ua] - clo[ua]) / VISIBILITY_TILE + 1;
+    int count = tiles_u * ((chi[va] - clo[va]) / VISIBILITY_TILE + 1);
+    int stride = int(gl_NumWorkGroups.y);
     float dp = dot(nrm, a);
     float su = -nrm[ua] / nrm[w], sv = -nrm[va] / nrm[w], s0 = dp / nrm[w];
-    for (int cu = clo[ua]; cu <= chi[ua]; ++cu) {
-        for (int cv = clo[va]; cv <= chi[va]; ++cv) {
-            // The plane's w over the column [cu, cu + 1] x [cv, cv + 1]:
-            // linear, so its extremes are at the corners.
-            float w00 = s0 + su * float(cu) + sv * float(cv);
-            float wlo = w00 + min(su, 0.0) + min(sv, 0.0) - MARGIN;
-            float whi = w00 + max(su, 0.0) + max(sv, 0.0) + MARGIN;
-            int w0 = max(clo[w], int(floor(wlo))), w1 = min(chi[w], int(floor(whi)));
-            for (int cw = w0; cw <= w1; ++cw) {
-                ivec3 cell;
-                cell[ua] = cu;
-                cell[va] = cv;
-                cell[w] = cw;
-                if (touches(cell, a, b, c)) set_sub_cell(cell);
+    for (int tile = int(gl_GlobalInvocationID.y); tile < count; tile += stride) {
+        int u0 = clo[ua] + (tile % tiles_u) * VISIBILITY_TILE;
+        int v0 = clo[va] + (tile / tiles_u) * VISIBILITY_TILE;
+        int u1 = min(chi[ua], u0 + VISIBILITY_TILE - 1), v1 = min(chi[va], v0 + VISIBILITY_TILE - 1);
+        for (int cu = u0; cu <= u1; ++cu) {
+            for (int cv = v0; cv <= v1; ++cv) {
+                // The plane's w over the column [cu, cu + 1] x [cv, cv + 1]:
+                // linear, so its extremes are at the corners.
+                float w00 = s0 + su * float(cu) + sv * float(cv);
+                float wlo = w00 + min(su, 0.0) + min(sv, 0.0) - MARGIN;
+                float whi = w00 + max(su, 0.0) + max(sv, 0.0) + MARGIN;
+                int w0 = max(clo[w], int(floor(wlo))), w1 = min(chi[w], int(floor(whi)));
+                for (int cw = w0; cw <= w1; ++cw) {
+                    ivec3 cell;
+                    cell[ua] = cu;
+                    cell[va] = cv;
+                    cell[w] = cw;
+                    if (touches(cell, a, b, c)) set_sub_cell(cell);
+                }
             }
         }
     }

@@ -275,17 +275,27 @@ pub struct VisibilityGridPass {
     /// The grid it clears and fills (bound in the frame set).
     buffer: vk::Buffer,
     bytes: u64,
-    /// Tiles of `TILE` x `TILE` columns (of sub-cells) a triangle's
-    /// invocations split it into.
+    /// Invocations per triangle, which share its tiles of `TILE` x `TILE`
+    /// columns (of sub-cells).
     tiles: u32,
     /// Finest cells per side.
     side: u32,
 }
 
 /// Columns per tile side of the voxelization (`VISIBILITY_TILE` in
-/// `shaders/visibility_grid.comp`): one invocation covers one tile of one
-/// triangle, within lavapipe's loop limit.
+/// `shaders/visibility_grid.comp`), within lavapipe's loop limit.
 pub const TILE: u32 = 32;
+
+/// Tiles one invocation of the voxelization takes at most: about 4,200 loop
+/// iterations each, 8 of them within lavapipe's 65,535.
+const TILES_PER_INVOCATION: u32 = 8;
+
+/// Invocations per triangle (the dispatch's y) for a grid of `columns`
+/// sub-cells per side: enough that a triangle across the whole grid, whose
+/// tiles they share, gives none more than `TILES_PER_INVOCATION`.
+pub fn invocations_per_triangle(columns: u32) -> u32 {
+    (columns.div_ceil(TILE).pow(2)).div_ceil(TILES_PER_INVOCATION)
+}
 
 impl VisibilityGridPass {
     /// For the grid `grid` (bound as set 0 binding 3 of `setup.frame`).
@@ -322,7 +332,7 @@ impl VisibilityGridPass {
             set,
             buffer: grid.buffer,
             bytes: memory(setup.settings),
-            tiles: (side * sub / TILE).max(1).pow(2),
+            tiles: invocations_per_triangle(side * sub),
             side,
         })
     }
@@ -354,7 +364,8 @@ impl VisibilityGridPass {
                 let mut first = 0;
                 while first < triangles {
                     let n = (triangles - first).min(TRIANGLES_PER_DISPATCH);
-                    // x: 64 triangles per workgroup; y: the column tiles.
+                    // x: 64 triangles per workgroup; y: the invocations that
+                    // share each triangle's tiles of columns.
                     let push = VisibilityGridPush {
                         first_index: draw.first_index,
                         vertex_offset: draw.vertex_offset,
@@ -448,6 +459,20 @@ mod tests {
                 words += m * m * m / 32;
             }
             assert_eq!(words * 4, grid_bytes(n as u32, 4));
+        }
+    }
+
+    #[test]
+    fn no_invocation_takes_more_than_eight_tiles() {
+        // The plain grid at 64: 2 x 2 tiles, one invocation; 4 sub-cells:
+        // 8 x 8 tiles, 8 invocations; a grid narrower than a tile: one.
+        assert_eq!(invocations_per_triangle(64), 1);
+        assert_eq!(invocations_per_triangle(256), 8);
+        assert_eq!(invocations_per_triangle(16), 1);
+        for columns in [16u32, 32, 64, 128, 256, 512, 1024, 4096] {
+            let tiles = columns.div_ceil(TILE).pow(2);
+            let y = invocations_per_triangle(columns);
+            assert!(tiles.div_ceil(y) <= TILES_PER_INVOCATION, "{columns}");
         }
     }
 
