@@ -10,17 +10,21 @@
 //! gathering method reads it through `shaders/visibility.glsl`. Nothing is
 //! kept across frames: the pass clears it, voxelizes every instance's
 //! triangles, posed by this frame's transforms, into the finest level of the
-//! cube [`grid_cube`] puts around them, then makes each coarser level the OR
-//! of the one below it (`shaders/visibility_grid_levels.comp`).
+//! cube [`grid_cube`] puts around them (the large triangles by whole
+//! workgroups, the rest one per invocation: [`TriangleOrder`]), then makes
+//! each coarser level the OR of the one below it
+//! (`shaders/visibility_grid_levels.comp`).
 //!
 //! Barriers (in `record`): the previous frame's readers (shaders of every
 //! stage, the readback copy) before the clear; the clear before the
-//! voxelization's atomics; the atomics before the first OR-level, each
-//! OR-level before the next; the last before every later reader.
+//! voxelization's atomics (none between its dispatches: they only OR bits
+//! in); the atomics before the first OR-level, each OR-level before the
+//! next; the last before every later reader.
 
 use super::INDIRECT_COMPUTE;
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::{self, RunUniforms, VisibilityGridLevelPush, VisibilityGridPush};
+use crate::scene::Scene;
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::RenderSettings;
 use crate::vk::barrier;
@@ -29,7 +33,7 @@ use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Result};
 use ash::vk;
-use glam::Vec3;
+use glam::{Mat3, Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 
 /// Which light patches see which receivers.
@@ -263,60 +267,153 @@ pub const LOOP_ITERATIONS_PER_EVALUATION: u64 = 15;
 /// What a fragment may spend on loops there, with room for its other loops.
 pub const LOOP_BUDGET: u64 = 61_440;
 
+/// Workgroup size of the voxelization (`local_size_x` of
+/// `shaders/visibility_grid.comp`).
+const WORKGROUP: u32 = 64;
+
 /// Triangles per dispatch: 64 per workgroup, at most 65,535 workgroups.
-const TRIANGLES_PER_DISPATCH: u32 = 64 * 65_535;
+const TRIANGLES_PER_DISPATCH: u32 = WORKGROUP * 65_535;
+
+/// A triangle is large where its bounding box can span more sub-cells than
+/// this a side (at most `(LARGE_SUBCELLS + 2)^2` columns otherwise): the
+/// large ones are marked by whole workgroups, the others each by one
+/// invocation.
+const LARGE_SUBCELLS: f32 = 64.0;
+
+/// Columns of one large triangle that one invocation takes at most: each
+/// is at most 4 sub-cells, about 6 loop iterations, so even 64 triangles
+/// across the whole grid in one workgroup stay within lavapipe's 65,535
+/// (docs/algorithm.md section 5, "Lavapipe's loop limit").
+const COLUMNS_PER_INVOCATION: u32 = 128;
+
+/// Rows of workgroups (the dispatch's y) for the large triangles of a grid
+/// of `columns` sub-cells a side: enough that the invocations of a
+/// workgroup's rows, sharing a triangle across the whole grid, take at most
+/// `COLUMNS_PER_INVOCATION` of its columns each.
+pub fn rows_per_triangle(columns: u32) -> u32 {
+    (columns * columns).div_ceil(WORKGROUP * COLUMNS_PER_INVOCATION)
+}
+
+/// Every mesh's triangles, largest first, for the voxelization to tell the
+/// large from the small each frame with one search per instance: the
+/// position of each one's first index (in the scene's index buffer, bound at
+/// set 1 binding 2 of `visibility_grid.comp`, at the triangle's own place),
+/// and per mesh each one's size, its bounding box's diagonal in the mesh's
+/// own space, falling.
+pub struct TriangleOrder {
+    pub first_indices: Vec<u32>,
+    pub sizes: Vec<Vec<f32>>,
+}
+
+impl TriangleOrder {
+    pub fn new(scene: &Scene) -> Self {
+        let (mut first_indices, mut sizes) = (vec![], vec![]);
+        let mut base = 0u32;
+        for mesh in &scene.meshes {
+            let size = |t: &[u32]| {
+                let p = |i: u32| Vec3::from(mesh.vertices[i as usize].position);
+                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+                (a.max(b).max(c) - a.min(b).min(c)).length()
+            };
+            let mut order: Vec<(f32, u32)> = mesh
+                .indices
+                .chunks_exact(3)
+                .enumerate()
+                .map(|(k, t)| (size(t), base + 3 * k as u32))
+                .collect();
+            // Largest first; ties in the mesh's order (a stable sort).
+            order.sort_by(|x, y| y.0.total_cmp(&x.0));
+            first_indices.extend(order.iter().map(|o| o.1));
+            sizes.push(order.iter().map(|o| o.0).collect());
+            base += mesh.indices.len() as u32;
+        }
+        TriangleOrder {
+            first_indices,
+            sizes,
+        }
+    }
+
+    /// How many of mesh `mesh`'s triangles are large under the transform
+    /// `world_from_object` in a grid of `per` sub-cells per unit of length:
+    /// those whose size, scaled by the transform's Frobenius norm (at least
+    /// its largest stretch), exceeds `LARGE_SUBCELLS` sub-cells.
+    pub fn large(&self, mesh: usize, world_from_object: &Mat4, per: f32) -> u32 {
+        let m = Mat3::from_mat4(*world_from_object);
+        let stretch =
+            (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared())
+                .sqrt();
+        // NaN or infinite transforms are refused when a frame is posed; a
+        // size that cannot be bounded counts as large.
+        self.sizes[mesh].partition_point(|&d| {
+            let x = d * stretch * per;
+            x > LARGE_SUBCELLS || x.is_nan()
+        }) as u32
+    }
+}
 
 /// Pass `visibility-grid`.
 pub struct VisibilityGridPass {
-    pipeline: Pipeline,
+    /// The voxelization of the large triangles and of the others
+    /// (`visibility_grid.comp` with `LARGE` true and false).
+    large: Pipeline,
+    small: Pipeline,
     /// The OR-levels (`visibility_grid_levels.comp`).
     levels: Pipeline,
     set: DescriptorSet,
+    order: TriangleOrder,
+    /// `order.first_indices` on the GPU (the set's binding 2).
+    _order: Buffer,
+    /// Each draw's mesh.
+    meshes: Vec<usize>,
     /// The grid it clears and fills (bound in the frame set).
     buffer: vk::Buffer,
     bytes: u64,
-    /// Invocations per triangle, which share its tiles of `TILE` x `TILE`
-    /// columns (of sub-cells).
-    tiles: u32,
-    /// Finest cells per side.
+    /// Rows of workgroups that share each large triangle's columns (of
+    /// sub-cells).
+    rows: u32,
+    /// Finest cells per side, and sub-cells per side of one.
     side: u32,
-}
-
-/// Columns per tile side of the voxelization (`VISIBILITY_TILE` in
-/// `shaders/visibility_grid.comp`), within lavapipe's loop limit.
-pub const TILE: u32 = 32;
-
-/// Tiles one invocation of the voxelization takes at most: about 4,200 loop
-/// iterations each, 8 of them within lavapipe's 65,535.
-const TILES_PER_INVOCATION: u32 = 8;
-
-/// Invocations per triangle (the dispatch's y) for a grid of `columns`
-/// sub-cells per side: enough that a triangle across the whole grid, whose
-/// tiles they share, gives none more than `TILES_PER_INVOCATION`.
-pub fn invocations_per_triangle(columns: u32) -> u32 {
-    (columns.div_ceil(TILE).pow(2)).div_ceil(TILES_PER_INVOCATION)
+    sub: u32,
 }
 
 impl VisibilityGridPass {
-    /// For the grid `grid` (bound as set 0 binding 3 of `setup.frame`).
-    pub fn new(setup: &Setup, grid: &Buffer) -> Result<Self> {
-        let scene = setup.scene;
+    /// For the grid `grid` (bound as set 0 binding 3 of `setup.frame`) of
+    /// `scene` (the CPU copy of `setup.scene`).
+    pub fn new(setup: &Setup, grid: &Buffer, scene: &Scene) -> Result<Self> {
+        let order = TriangleOrder::new(scene);
+        let order_buffer = Buffer::with_data(
+            setup.gpu,
+            "visibility-grid triangle order",
+            bytemuck::cast_slice(&order.first_indices),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let gpu_scene = setup.scene;
         let set = DescriptorSet::new(
             setup.gpu,
             "visibility-grid",
             &[
-                Binding::storage("Vertices", &scene.vertices),
-                Binding::storage("Indices", &scene.indices),
+                Binding::storage("Vertices", &gpu_scene.vertices),
+                Binding::storage("Indices", &gpu_scene.indices),
+                Binding::storage("Order", &order_buffer),
             ],
         )?;
-        let pipeline = Pipeline::compute(
-            setup.gpu,
-            "visibility-grid",
-            "visibility_grid.comp",
-            &[setup.frame, &set],
-            std::mem::size_of::<VisibilityGridPush>() as u32,
-            &specialization(setup.settings),
-        )?;
+        let voxelization = |large: bool| {
+            let mut constants = specialization(setup.settings).to_vec();
+            constants.push((12, large as i32));
+            Pipeline::compute(
+                setup.gpu,
+                if large {
+                    "visibility-grid large triangles"
+                } else {
+                    "visibility-grid"
+                },
+                "visibility_grid.comp",
+                &[setup.frame, &set],
+                std::mem::size_of::<VisibilityGridPush>() as u32,
+                &constants,
+            )
+        };
+        let (large, small) = (voxelization(true)?, voxelization(false)?);
         let levels = Pipeline::compute(
             setup.gpu,
             "visibility-grid levels",
@@ -327,21 +424,34 @@ impl VisibilityGridPass {
         )?;
         let (side, sub) = (GRID.get(setup.settings), SUBCELLS.get(setup.settings));
         Ok(Self {
-            pipeline,
+            large,
+            small,
             levels,
             set,
+            order,
+            _order: order_buffer,
+            meshes: scene.instances.iter().map(|i| i.mesh).collect(),
             buffer: grid.buffer,
             bytes: memory(setup.settings),
-            tiles: invocations_per_triangle(side * sub),
+            rows: rows_per_triangle(side * sub),
             side,
+            sub,
         })
     }
 
-    /// Clears the grid, voxelizes every instance into its finest level and
-    /// makes the OR-levels.
-    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+    /// Clears the grid, voxelizes every instance, posed by
+    /// `instance_transforms` in the grid's cube `cube` (of this frame), into
+    /// its finest level and makes the OR-levels.
+    pub fn record(
+        &self,
+        ctx: &FrameContext,
+        profiler: &mut Profiler,
+        cube: [f32; 4],
+        instance_transforms: &[Mat4],
+    ) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        let per = self.sub as f32 / cube[3];
         profiler.pass(gpu, cmd, "visibility-grid", INDIRECT_COMPUTE, || unsafe {
             // The previous frame's gathers (and readback) read it before it
             // is cleared; the clear comes before the atomics.
@@ -353,35 +463,48 @@ impl VisibilityGridPass {
                 (barrier::READERS, vk::AccessFlags2::NONE),
                 (vk::PipelineStageFlags2::COMPUTE_SHADER, rw),
             );
-            self.pipeline.bind(
-                gpu,
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                &[ctx.frame_set, self.set.set],
-            );
-            for draw in &ctx.scene.draws {
-                let triangles = draw.index_count / 3;
-                let mut first = 0;
-                while first < triangles {
-                    let n = (triangles - first).min(TRIANGLES_PER_DISPATCH);
-                    // x: 64 triangles per workgroup; y: the invocations that
-                    // share each triangle's tiles of columns.
-                    let push = VisibilityGridPush {
-                        first_index: draw.first_index,
-                        vertex_offset: draw.vertex_offset,
-                        instance: draw.push.instance,
-                        first_triangle: first,
-                        triangles: n,
+            // Each draw's triangles, largest first (`TriangleOrder`): the
+            // large ones by whole workgroups, which the dispatch's y rows
+            // share too, then the rest by one invocation each. Both only
+            // OR bits in with atomics: in any order, the same grid.
+            let large = |d: usize| {
+                let draw = &ctx.scene.draws[d];
+                let m = &instance_transforms[draw.push.instance as usize];
+                self.order.large(self.meshes[d], m, per)
+            };
+            for (pipeline, is_large) in [(&self.large, true), (&self.small, false)] {
+                pipeline.bind(
+                    gpu,
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    &[ctx.frame_set, self.set.set],
+                );
+                for (d, draw) in ctx.scene.draws.iter().enumerate() {
+                    let l = large(d);
+                    let (mut first, end) = match is_large {
+                        true => (0, l),
+                        false => (l, draw.index_count / 3),
                     };
-                    gpu.device.cmd_push_constants(
-                        cmd,
-                        self.pipeline.layout,
-                        vk::ShaderStageFlags::COMPUTE,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
-                    gpu.device.cmd_dispatch(cmd, n.div_ceil(64), self.tiles, 1);
-                    first += n;
+                    let rows = if is_large { self.rows } else { 1 };
+                    while first < end {
+                        let n = (end - first).min(TRIANGLES_PER_DISPATCH);
+                        let push = VisibilityGridPush {
+                            first_index: draw.first_index,
+                            vertex_offset: draw.vertex_offset,
+                            instance: draw.push.instance,
+                            first_triangle: first,
+                            triangles: n,
+                        };
+                        gpu.device.cmd_push_constants(
+                            cmd,
+                            pipeline.layout,
+                            vk::ShaderStageFlags::COMPUTE,
+                            0,
+                            bytemuck::bytes_of(&push),
+                        );
+                        gpu.device.cmd_dispatch(cmd, n.div_ceil(WORKGROUP), rows, 1);
+                        first += n;
+                    }
                 }
             }
             // Each OR-level reads the level below it whole: the
@@ -463,16 +586,17 @@ mod tests {
     }
 
     #[test]
-    fn no_invocation_takes_more_than_eight_tiles() {
-        // The plain grid at 64: 2 x 2 tiles, one invocation; 4 sub-cells:
-        // 8 x 8 tiles, 8 invocations; a grid narrower than a tile: one.
-        assert_eq!(invocations_per_triangle(64), 1);
-        assert_eq!(invocations_per_triangle(256), 8);
-        assert_eq!(invocations_per_triangle(16), 1);
+    fn no_invocation_takes_more_than_its_columns_of_a_large_triangle() {
+        // The plain grid at 64: one row; 4 sub-cells at 64: 8 rows.
+        assert_eq!(rows_per_triangle(64), 1);
+        assert_eq!(rows_per_triangle(256), 8);
+        assert_eq!(rows_per_triangle(16), 1);
         for columns in [16u32, 32, 64, 128, 256, 512, 1024, 4096] {
-            let tiles = columns.div_ceil(TILE).pow(2);
-            let y = invocations_per_triangle(columns);
-            assert!(tiles.div_ceil(y) <= TILES_PER_INVOCATION, "{columns}");
+            let shared = WORKGROUP * rows_per_triangle(columns);
+            assert!(
+                (columns * columns).div_ceil(shared) <= COLUMNS_PER_INVOCATION,
+                "{columns}"
+            );
         }
     }
 

@@ -175,7 +175,7 @@ impl<'g> Renderer<'g> {
         // viewer can switch to one that reads it; recorded only for those.
         let grid_in_use = reads_grid(descriptor, settings);
         let visibility_pass = match visibility_grid::uses_voxels(settings) {
-            true => Some(VisibilityGridPass::new(&setup, &visibility_grid)?),
+            true => Some(VisibilityGridPass::new(&setup, &visibility_grid, scene)?),
             false => None,
         };
         drop(first);
@@ -359,6 +359,7 @@ impl<'g> Renderer<'g> {
                 view.face.filter(|_| first).map(|_| view.light as u32)
             })
             .collect();
+        let cube = self.visibility_cube();
         let Self {
             slots,
             method,
@@ -404,7 +405,7 @@ impl<'g> Renderer<'g> {
                 self.gbuffer.record(&ctx(cmds[c], v), p);
                 // The posed scene's occupancy, shared by every light view.
                 if let Some(grid) = self.visibility_pass.as_ref().filter(|_| self.grid_in_use) {
-                    grid.record(&ctx(cmds[c], v), p);
+                    grid.record(&ctx(cmds[c], v), p, cube, &self.state.instance_transforms);
                 }
                 p.set_label(labels[i].clone());
             }
