@@ -33,8 +33,11 @@ use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Result};
 use ash::vk;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
+
+mod triangle_order;
+pub use triangle_order::TriangleOrder;
 
 /// Which light patches see which receivers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -274,12 +277,6 @@ const WORKGROUP: u32 = 64;
 /// Triangles per dispatch: 64 per workgroup, at most 65,535 workgroups.
 const TRIANGLES_PER_DISPATCH: u32 = WORKGROUP * 65_535;
 
-/// A triangle is large where its bounding box can span more sub-cells than
-/// this a side (at most `(LARGE_SUBCELLS + 2)^2` columns otherwise): the
-/// large ones are marked by whole workgroups, the others each by one
-/// invocation.
-const LARGE_SUBCELLS: f32 = 64.0;
-
 /// Columns of one large triangle that one invocation takes at most: each
 /// is at most 4 sub-cells, about 6 loop iterations, so even 64 triangles
 /// across the whole grid in one workgroup stay within lavapipe's 65,535
@@ -292,63 +289,6 @@ const COLUMNS_PER_INVOCATION: u32 = 128;
 /// `COLUMNS_PER_INVOCATION` of its columns each.
 pub fn rows_per_triangle(columns: u32) -> u32 {
     (columns * columns).div_ceil(WORKGROUP * COLUMNS_PER_INVOCATION)
-}
-
-/// Every mesh's triangles, largest first, for the voxelization to tell the
-/// large from the small each frame with one search per instance: the
-/// position of each one's first index (in the scene's index buffer, bound at
-/// set 1 binding 2 of `visibility_grid.comp`, at the triangle's own place),
-/// and per mesh each one's size, its bounding box's diagonal in the mesh's
-/// own space, falling.
-pub struct TriangleOrder {
-    pub first_indices: Vec<u32>,
-    pub sizes: Vec<Vec<f32>>,
-}
-
-impl TriangleOrder {
-    pub fn new(scene: &Scene) -> Self {
-        let (mut first_indices, mut sizes) = (vec![], vec![]);
-        let mut base = 0u32;
-        for mesh in &scene.meshes {
-            let size = |t: &[u32]| {
-                let p = |i: u32| Vec3::from(mesh.vertices[i as usize].position);
-                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-                (a.max(b).max(c) - a.min(b).min(c)).length()
-            };
-            let mut order: Vec<(f32, u32)> = mesh
-                .indices
-                .chunks_exact(3)
-                .enumerate()
-                .map(|(k, t)| (size(t), base + 3 * k as u32))
-                .collect();
-            // Largest first; ties in the mesh's order (a stable sort).
-            order.sort_by(|x, y| y.0.total_cmp(&x.0));
-            first_indices.extend(order.iter().map(|o| o.1));
-            sizes.push(order.iter().map(|o| o.0).collect());
-            base += mesh.indices.len() as u32;
-        }
-        TriangleOrder {
-            first_indices,
-            sizes,
-        }
-    }
-
-    /// How many of mesh `mesh`'s triangles are large under the transform
-    /// `world_from_object` in a grid of `per` sub-cells per unit of length:
-    /// those whose size, scaled by the transform's Frobenius norm (at least
-    /// its largest stretch), exceeds `LARGE_SUBCELLS` sub-cells.
-    pub fn large(&self, mesh: usize, world_from_object: &Mat4, per: f32) -> u32 {
-        let m = Mat3::from_mat4(*world_from_object);
-        let stretch =
-            (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared())
-                .sqrt();
-        // NaN or infinite transforms are refused when a frame is posed; a
-        // size that cannot be bounded counts as large.
-        self.sizes[mesh].partition_point(|&d| {
-            let x = d * stretch * per;
-            x > LARGE_SUBCELLS || x.is_nan()
-        }) as u32
-    }
 }
 
 /// Pass `visibility-grid`.
