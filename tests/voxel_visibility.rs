@@ -246,17 +246,9 @@ fn the_grid_marks_the_boxs_walls_and_leaves_its_inside_empty() {
     let room = cornell_at_rest(false);
     let n = 16u32;
     let s = voxels(sized("reference", 16, 16, 16), n);
-    let mut r = isr::renderer::Renderer::new(&gpu, &room, &s).unwrap();
-    r.render_frames(1, |_| {}).unwrap();
-    let words: Vec<u32> = bytemuck::cast_slice(
-        &isr::readback::read_buffer(&gpu, r.visibility_grid().unwrap()).unwrap(),
-    )
-    .to_vec();
-    let cube = r.visibility_cube();
-    let origin = r.render_origin().as_vec3();
+    let (words, cube, origin) = rendered_grid(&gpu, &room, &s);
+    let origin = origin.as_vec3();
     let (lo, hi) = room.bounds().unwrap();
-    drop(r);
-    assert_validation_clean(&gpu);
     let corner = Vec3::new(cube[0], cube[1], cube[2]) + origin;
     let cell = cube[3];
     // Whether a quad of the room lies in the plane coordinate `axis` = p

@@ -159,16 +159,7 @@ fn the_voxelization_marks_the_sub_cells_each_triangle_touches() {
     let (n, sub) = (64u32, 4u32);
     let settings = voxels(sized("reference", 16, 16, 16), n);
     assert_eq!((GRID.get(&settings), SUBCELLS.get(&settings)), (n, sub));
-    let mut r = isr::renderer::Renderer::new(&gpu, &s, &settings).unwrap();
-    r.render_frames(1, |_| {}).unwrap();
-    let words: Vec<u32> = bytemuck::cast_slice(
-        &isr::readback::read_buffer(&gpu, r.visibility_grid().unwrap()).unwrap(),
-    )
-    .to_vec();
-    let cube = r.visibility_cube();
-    let origin = r.render_origin();
-    drop(r);
-    assert_validation_clean(&gpu);
+    let (words, cube, origin) = rendered_grid(&gpu, &s, &settings);
 
     // Sub-cells of the whole grid: `side` a side, each `size` long.
     let side = (n * sub) as usize;

@@ -569,6 +569,26 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
     d
 }
 
+/// The voxel grid after one frame of `scene` with `settings` (which use it):
+/// its words as read back (`shaders/visibility_layout.glsl`), its cube
+/// (`Renderer::visibility_cube`, relative to the render origin) and the
+/// render origin. Fails the test if validation spoke.
+pub fn rendered_grid(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> (Vec<u32>, [f32; 4], DVec3) {
+    let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
+    r.render_frames(1, |_| {}).expect("rendering");
+    let grid = r.visibility_grid().expect("a run with the voxel grid");
+    let words =
+        bytemuck::cast_slice(&isr::readback::read_buffer(gpu, grid).expect("readback")).to_vec();
+    let (cube, origin) = (r.visibility_cube(), r.render_origin());
+    drop(r);
+    assert_validation_clean(gpu);
+    (words, cube, origin)
+}
+
 /// `s` with `--visibility voxels` at grid side `n`.
 pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
     use isr::passes::visibility_grid::{Visibility, GRID, VISIBILITY};
