@@ -4,7 +4,8 @@
 //! KHR_lights_punctual (not the library's own `Light` methods), CPU sums,
 //! and the bench's error measures (`isr::bench::metrics`). Submodules:
 //! `cli`, the one runner of the `isr` binary; `gltf`, the one builder of
-//! glTF and GLB files; `measure`, work counted on this thread (allocations,
+//! glTF and GLB files; `grid`, the voxel visibility settings and the grid
+//! read back; `measure`, work counted on this thread (allocations,
 //! bytes read).
 //!
 //! Tests that need Vulkan fail with a clear message when no device is found:
@@ -13,7 +14,12 @@
 
 pub mod cli;
 pub mod gltf;
+pub mod grid;
 pub mod measure;
+
+// Every test binary compiles this kit; most use no grid helper.
+#[allow(unused_imports)]
+pub use grid::*;
 
 use glam::{DVec3, Vec3};
 use isr::readback::Readback;
@@ -567,46 +573,4 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// The voxel grid after one frame of `scene` with `settings` (which use it):
-/// its words as read back (`shaders/visibility_layout.glsl`), its cube
-/// (`Renderer::visibility_cube`, relative to the render origin) and the
-/// render origin. Fails the test if validation spoke.
-pub fn rendered_grid(
-    gpu: &Gpu,
-    scene: &Scene,
-    settings: &RenderSettings,
-) -> (Vec<u32>, [f32; 4], DVec3) {
-    let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
-    r.render_frames(1, |_| {}).expect("rendering");
-    let grid = r.visibility_grid().expect("a run with the voxel grid");
-    let words =
-        bytemuck::cast_slice(&isr::readback::read_buffer(gpu, grid).expect("readback")).to_vec();
-    let (cube, origin) = (r.visibility_cube(), r.render_origin());
-    drop(r);
-    assert_validation_clean(gpu);
-    (words, cube, origin)
-}
-
-/// `s` with `--visibility voxels` at grid side `n`.
-pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
-    use isr::passes::visibility_grid::{Visibility, GRID, VISIBILITY};
-    VISIBILITY.set(&mut s, Visibility::Voxels);
-    GRID.set(&mut s, n);
-    s
-}
-
-/// `s` with the plain grid: one bit per finest cell, no sub-cells
-/// (`--visibility-subcells 1`).
-pub fn plain_grid(mut s: RenderSettings) -> RenderSettings {
-    isr::passes::visibility_grid::SUBCELLS.set(&mut s, 1);
-    s
-}
-
-/// `s` with HISR marching from every receiver (`--hisr-shared-visibility
-/// off`; the default shares the tiles' visibility).
-pub fn per_receiver(mut s: RenderSettings) -> RenderSettings {
-    isr::methods::hisr::SHARED_VISIBILITY.set(&mut s, false);
-    s
 }
