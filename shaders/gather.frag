@@ -20,13 +20,13 @@
 
 layout(early_fragment_tests) in;
 
-layout(constant_id = 0) const int LIGHT_PATCHES = 0;
+layout(constant_id = 14) const int LIGHT_PATCHES = 0;
 // HISR with tiles and --visibility voxels: the tiles' shared visibility
 // (hisr_visibility.comp, --hisr-shared-visibility).
-layout(constant_id = 1) const bool SHARED_VISIBILITY = false;
+layout(constant_id = 30) const bool SHARED_VISIBILITY = false;
 // --hisr-shared-refine: the corners' spread past which a receiver marches
 // a patch itself (next_entry; hisr_visibility.comp sets the bits); 1 never does.
-layout(constant_id = 2) const float REFINE_SPREAD = 1.0;
+layout(constant_id = 31) const float REFINE_SPREAD = 1.0;
 
 layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (geo_levels.glsl)
 layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L

@@ -52,7 +52,7 @@ layout(push_constant) uniform Push {
 // the union of its finest tiles' boxes (min and max are exact, so it is the
 // box of its positions), so each G-buffer position is read once, not once per
 // level (the coarsest level's few invocations each read 4096 of them).
-layout(constant_id = 0) const bool BOXES = false;
+layout(constant_id = 32) const bool BOXES = false;
 
 const vec3 EMPTY_LO = vec3(3.0e38);
 const vec3 EMPTY_HI = vec3(-3.0e38);

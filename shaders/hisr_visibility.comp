@@ -29,7 +29,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 // --hisr-shared-refine (gather.frag's REFINE_SPREAD): the corners' spread
 // past which every receiver marches an entry itself; 1: none does.
-layout(constant_id = 0) const float REFINE_SPREAD = 1.0;
+layout(constant_id = 31) const float REFINE_SPREAD = 1.0;
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;  // xyz world, w view depth (0: background)
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;

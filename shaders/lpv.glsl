@@ -10,8 +10,8 @@
 #ifndef LPV_GLSL
 #define LPV_GLSL
 
-layout(constant_id = 0) const int LPV_SIZE = 32;
-layout(constant_id = 1) const int LPV_CASCADES = 3;
+layout(constant_id = 40) const int LPV_SIZE = 32;
+layout(constant_id = 41) const int LPV_CASCADES = 3;
 
 // Cells of all cascades: cascade c, cell (x, y, z) is cell
 // ((c * N + z) * N + y) * N + x. The injection images are 2D arrays of

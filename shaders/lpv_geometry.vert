@@ -18,9 +18,9 @@
 #include "lpv.glsl"
 #include "lpv_point.glsl"
 
-layout(constant_id = 2) const bool FROM_GBUFFER = false;
-layout(constant_id = 3) const int LPV_LEVEL = 0;   // RSM quadtree level of the surfels
-layout(constant_id = 4) const int LPV_STRIDE = 1;  // G-buffer pixels per surfel side
+layout(constant_id = 43) const bool FROM_GBUFFER = false;
+layout(constant_id = 44) const int LPV_LEVEL = 0;   // RSM quadtree level of the surfels
+layout(constant_id = 45) const int LPV_STRIDE = 1;  // G-buffer pixels per surfel side
 
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;

@@ -12,7 +12,7 @@
 #include "lpv.glsl"
 #include "lpv_point.glsl"
 
-layout(constant_id = 2) const int LPV_LEVEL = 0;  // RSM quadtree level of the VPLs
+layout(constant_id = 44) const int LPV_LEVEL = 0;  // RSM quadtree level of the VPLs
 
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;

@@ -21,7 +21,7 @@
 #include "lpv.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(constant_id = 2) const bool OCCLUSION = true;
+layout(constant_id = 42) const bool OCCLUSION = true;
 
 // Three planes of LPV_CELLS cells: the red, green and blue SH.
 layout(set = 1, binding = 0, std430) readonly buffer LpvSource { vec4 source[]; };

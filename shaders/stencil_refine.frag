@@ -16,7 +16,7 @@ layout(set = 1, binding = 3) uniform sampler2D gbuffer_normal;
 #define GEO_FLAGS
 #include "geo_levels.glsl"
 
-layout(constant_id = 0) const bool COUNT = true;
+layout(constant_id = 13) const bool COUNT = true;
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);

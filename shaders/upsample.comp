@@ -25,9 +25,9 @@ layout(set = 1, binding = 3, rgba32f) uniform image2DArray taps;
 // of a branch under a lane mask, so a branch on a push constant would cost
 // every invocation the code of every kind. INTERPOLATE comes from the
 // settings the pass is built with (new settings rebuild the passes).
-layout(constant_id = 0) const bool PULL = false;  // pull into `level` from level - 1; else push from level + 1
-layout(constant_id = 1) const bool WRITE_TAPS = false;  // a pull that finalises `level` (L); pushes always do
-layout(constant_id = 2) const bool INTERPOLATE = true;
+layout(constant_id = 10) const bool PULL = false;  // pull into `level` from level - 1; else push from level + 1
+layout(constant_id = 11) const bool WRITE_TAPS = false;  // a pull that finalises `level` (L); pushes always do
+layout(constant_id = 12) const bool INTERPOLATE = true;
 
 layout(push_constant) uniform Push { int level; };
 

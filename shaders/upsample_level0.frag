@@ -12,7 +12,7 @@
 layout(set = 1, binding = 0, rgba32f) readonly uniform image2DArray illumination;
 layout(set = 1, binding = 1, rgba32f) readonly uniform image2DArray taps;
 
-layout(constant_id = 2) const bool INTERPOLATE = true;
+layout(constant_id = 12) const bool INTERPOLATE = true;
 
 #include "upsample.glsl"
 

@@ -186,7 +186,7 @@ void mark_column(Columns t, int cu, int cv) {
 // Which triangles this dispatch marks (visibility_grid.rs): the large ones,
 // those whose bounding box can span more than a few sub-cells a side, each
 // by the whole workgroup, or the others, each by its own invocation.
-layout(constant_id = 12) const bool LARGE = false;
+layout(constant_id = 22) const bool LARGE = false;
 
 // The mesh's triangles, largest first: each the position of its first index
 // in Indices (visibility_grid.rs, `TriangleOrder`), at the same place as the

@@ -16,7 +16,7 @@
 // Sub-cells per side of a finest cell: 1, 2 or 4 (`--visibility-subcells`,
 // passes::visibility_grid::specialization, which every pipeline that
 // includes this file is made with).
-layout(constant_id = 11) const int GRID_SUB = 4;
+layout(constant_id = 21) const int GRID_SUB = 4;
 
 // Words before level k: sum over i < k of level i's words, (N >> i)^3 / 32
 // for a level of bits = (N^3 - (N >> k)^3) / 28 (a geometric sum of ratio

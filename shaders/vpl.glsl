@@ -6,7 +6,7 @@
 // Whether the march is compiled in at all (src/passes/visibility_grid.rs
 // sets it from --visibility): a uniform branch around it cost lavapipe
 // 1.3-2.7x on every gather and splat without the grid.
-layout(constant_id = 10) const bool VOXEL_VISIBILITY = false;
+layout(constant_id = 20) const bool VOXEL_VISIBILITY = false;
 
 // C_{j->i} / rho_i: the irradiance a patch with flux phi (W), world area a
 // (m^2), position xj and unit normal nj, at level `level` (patch_level), gives

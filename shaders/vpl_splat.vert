@@ -8,7 +8,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 
-layout(constant_id = 0) const bool RESTRICTED = false;
+layout(constant_id = 50) const bool RESTRICTED = false;
 
 layout(set = 1, binding = 2) uniform sampler2D rsm_position;
 layout(set = 1, binding = 3) uniform sampler2D rsm_normal;

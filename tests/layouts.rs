@@ -423,3 +423,80 @@ mod bindings {
         }
     }
 }
+
+/// Specialization constants are set by name (`vk::specialization`): every
+/// one a shader declares has a name, and a name means one id and one type in
+/// every shader that declares it, so an id never means two things.
+#[test]
+fn every_specialization_constant_has_one_name_id_and_type() {
+    use std::collections::HashMap;
+    let mut seen: HashMap<String, (u32, isr::vk::reflect::SpecKind, &str)> = HashMap::new();
+    let mut ids: HashMap<u32, String> = HashMap::new();
+    for shader in isr::vk::pipeline::shader_names() {
+        let words = isr::vk::pipeline::spirv(shader).unwrap();
+        for c in isr::vk::reflect::spec_constants(&words).unwrap() {
+            println!("{shader}: {} = {} ({:?})", c.name, c.id, c.kind);
+            assert!(
+                !c.name.is_empty(),
+                "{shader}: constant {} has no name",
+                c.id
+            );
+            match seen.get(&c.name) {
+                Some(&(id, kind, first)) => assert_eq!(
+                    (id, kind),
+                    (c.id, c.kind),
+                    "{} is id {id} ({kind:?}) in {first} but id {} ({:?}) in {shader}",
+                    c.name,
+                    c.id,
+                    c.kind
+                ),
+                None => {
+                    seen.insert(c.name.clone(), (c.id, c.kind, shader));
+                }
+            }
+            let name = ids.entry(c.id).or_insert_with(|| c.name.clone());
+            assert_eq!(
+                *name, c.name,
+                "id {} names both {name} and {} ({shader})",
+                c.id, c.name
+            );
+        }
+    }
+}
+
+/// A pipeline sets its shaders' specialization constants by name, checked
+/// against their SPIR-V when it is made: a missing, unknown, repeated or
+/// mistyped constant fails.
+mod specialization {
+    use isr::vk::pipeline::{check_specialization, Spec};
+
+    const SHADERS: [&str; 2] = ["layered.vert", "stencil_refine.frag"];
+
+    #[test]
+    fn the_constants_the_shaders_declare_pass() {
+        check_specialization("stencil-refine", &SHADERS, &[Spec::bool("COUNT", true)]).unwrap();
+    }
+
+    #[test]
+    fn missing_unknown_repeated_and_mistyped_constants_are_rejected() {
+        let e = check_specialization("stencil-refine", &SHADERS, &[]).unwrap_err();
+        assert!(e.to_string().contains("does not set"), "{e}");
+        let e = check_specialization(
+            "stencil-refine",
+            &SHADERS,
+            &[Spec::bool("COUNT", true), Spec::bool("CONUT", true)],
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("none of its shaders"), "{e}");
+        let e = check_specialization(
+            "stencil-refine",
+            &SHADERS,
+            &[Spec::bool("COUNT", true), Spec::bool("COUNT", false)],
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("twice"), "{e}");
+        let e =
+            check_specialization("stencil-refine", &SHADERS, &[Spec::int("COUNT", 1)]).unwrap_err();
+        assert!(e.to_string().contains("as Bool"), "{e}");
+    }
+}

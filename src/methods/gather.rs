@@ -11,7 +11,7 @@ use super::multires_method::{FillPass, LightSpacePass};
 use crate::frame::{FrameContext, Setup};
 use crate::multires::MultiresBuffer;
 use crate::passes::INDIRECT_GRAPHICS;
-use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, StencilTest};
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, Spec, StencilTest};
 use crate::vk::profiler::Profiler;
 use anyhow::{anyhow, Result};
 use ash::vk;
@@ -83,9 +83,9 @@ impl GatherPass {
                 },
                 stencil: stencil.then_some(StencilTest::EQUAL_ONE),
                 specialization: &[
-                    (0, source as i32),
-                    (1, shared.is_some() as i32),
-                    (2, shared.unwrap_or(1.0).to_bits() as i32),
+                    Spec::int("LIGHT_PATCHES", source as i32),
+                    Spec::bool("SHARED_VISIBILITY", shared.is_some()),
+                    Spec::float("REFINE_SPREAD", shared.unwrap_or(1.0)),
                     visibility[0],
                     visibility[1],
                 ],

@@ -425,7 +425,7 @@ impl CutPass {
                 "hisr_cut.comp",
                 std::slice::from_ref(&bindings),
                 push_bytes,
-                &[(0, boxes as i32)],
+                &[crate::vk::pipeline::Spec::bool("BOXES", boxes)],
             )
         };
         let visibility = match shares_visibility(setup.settings) {
@@ -443,7 +443,10 @@ impl CutPass {
                 // REFINE_SPREAD: which entries get their march bit; the
                 // grid's layout and march.
                 &[
-                    (0, SHARED_REFINE.get(setup.settings).to_bits() as i32),
+                    crate::vk::pipeline::Spec::float(
+                        "REFINE_SPREAD",
+                        SHARED_REFINE.get(setup.settings),
+                    ),
                     crate::passes::visibility_grid::specialization(setup.settings)[1],
                 ],
             )?),

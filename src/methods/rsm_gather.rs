@@ -64,6 +64,7 @@ impl RsmGather {
             "rsm_gather.frag",
             &full_resolution_bindings(setup),
             8,
+            &crate::passes::visibility_grid::specialization(setup.settings),
             |t| &t.indirect,
         )?))
     }

@@ -119,7 +119,11 @@ impl RsmSplat {
                 fragment_shader: "vpl_splat.frag",
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &[(0, restricted as i32), visibility[0], visibility[1]],
+                specialization: &[
+                    crate::vk::pipeline::Spec::bool("RESTRICTED", restricted),
+                    visibility[0],
+                    visibility[1],
+                ],
                 ..Default::default()
             },
         )?;

@@ -50,7 +50,7 @@ impl StencilRefinePass {
                     fragment_shader: "stencil_refine.frag",
                     stencil_format: m.stencil.format,
                     stencil: Some(StencilTest::WRITE_ONE),
-                    specialization: &[(0, count as i32)],
+                    specialization: &[crate::vk::pipeline::Spec::bool("COUNT", count)],
                     ..Default::default()
                 },
             )

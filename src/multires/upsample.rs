@@ -11,7 +11,7 @@ use super::{MultiresBuffer, Upsample};
 use crate::frame::{FrameContext, Setup};
 use crate::passes::{begin_rendering, Attachments, ComputePass, INDIRECT_COMPUTE};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline};
+use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, Spec};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
@@ -28,12 +28,6 @@ pub struct UpsamplePass {
     level_zero: PassPipeline,
 }
 
-/// Specialisation constant ids of `upsample.comp` (INTERPOLATE also of
-/// `upsample_level0.frag`).
-const PULL: u32 = 0;
-const WRITE_TAPS: u32 = 1;
-const INTERPOLATE: u32 = 2;
-
 impl UpsamplePass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
         let (t, s) = (setup.targets, setup.samplers);
@@ -44,7 +38,10 @@ impl UpsamplePass {
             Binding::storage_image("taps", m.upsample_taps.view),
         ];
         // From these settings; a change of settings rebuilds the passes.
-        let interpolate = (super::UPSAMPLE.get(setup.settings) == Upsample::Interpolated) as i32;
+        let interpolate = Spec::bool(
+            "INTERPOLATE",
+            super::UPSAMPLE.get(setup.settings) == Upsample::Interpolated,
+        );
         let pass = |pull: bool, taps: bool| {
             ComputePass::new(
                 setup,
@@ -53,9 +50,9 @@ impl UpsamplePass {
                 std::slice::from_ref(&bindings),
                 4,
                 &[
-                    (PULL, pull as i32),
-                    (WRITE_TAPS, taps as i32),
-                    (INTERPOLATE, interpolate),
+                    Spec::bool("PULL", pull),
+                    Spec::bool("WRITE_TAPS", taps),
+                    interpolate,
                 ],
             )
         };
@@ -70,7 +67,7 @@ impl UpsamplePass {
                 name: "upsample",
                 fragment_shader: "upsample_level0.frag",
                 color_formats: &[t.indirect.format],
-                specialization: &[(INTERPOLATE, interpolate)],
+                specialization: &[interpolate],
                 ..Default::default()
             },
         )?;

@@ -21,6 +21,7 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         "composite.frag",
         &bindings,
         0,
+        &[],
         |t| &t.final_radiance,
     )
 }

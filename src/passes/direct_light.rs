@@ -22,6 +22,7 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         "direct_light.frag",
         &bindings,
         0,
+        &[],
         |t| &t.direct,
     )
 }

@@ -29,7 +29,7 @@ pub mod visibility_grid;
 
 use crate::frame::{FrameContext, SceneGpu, Setup, Targets};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, PassPipeline, Pipeline};
+use crate::vk::pipeline::{Binding, DescriptorSet, GraphicsDesc, PassPipeline, Pipeline, Spec};
 use crate::vk::profiler::{PassKind, Profiler};
 use crate::vk::{Gpu, Image};
 use anyhow::Result;
@@ -214,8 +214,8 @@ impl ScenePass {
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
                 specialization: &[
-                    (0, setup.scene.texture_count() as i32),
-                    (1, from_light as i32),
+                    Spec::int("TEXTURE_COUNT", setup.scene.texture_count() as i32),
+                    Spec::int("VIEW_FROM_LIGHT", from_light as i32),
                 ],
                 ..Default::default()
             },
@@ -322,6 +322,7 @@ impl FullscreenPass {
         fragment_shader: &str,
         bindings: &[Binding],
         push_constant_bytes: u32,
+        specialization: &[Spec],
         output: fn(&Targets) -> &Image,
     ) -> Result<Self> {
         let pipeline = PassPipeline::graphics(
@@ -334,7 +335,7 @@ impl FullscreenPass {
                 fragment_shader,
                 push_constant_bytes,
                 color_formats: &[output(setup.targets).format],
-                specialization: &visibility_grid::specialization(setup.settings),
+                specialization,
                 ..Default::default()
             },
         )?;
@@ -404,7 +405,7 @@ impl ComputePass {
         shader: &str,
         variants: &[Vec<Binding>],
         push_constant_bytes: u32,
-        specialization: &[(u32, i32)],
+        specialization: &[Spec],
     ) -> Result<Self> {
         let sets = variants
             .iter()

@@ -83,7 +83,10 @@ impl CubeRsmPass {
                 depth_format: DEPTH_FORMAT,
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
-                specialization: &[(0, setup.scene.texture_count() as i32)],
+                specialization: &[crate::vk::pipeline::Spec::int(
+                    "TEXTURE_COUNT",
+                    setup.scene.texture_count() as i32,
+                )],
                 ..Default::default()
             },
         )?;

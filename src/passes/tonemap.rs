@@ -21,6 +21,7 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         "tonemap.frag",
         &bindings,
         0,
+        &[],
         |t| &t.display,
     )
 }

@@ -28,7 +28,7 @@ use crate::scene::Scene;
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::RenderSettings;
 use crate::vk::barrier;
-use crate::vk::pipeline::{Binding, DescriptorSet, Pipeline};
+use crate::vk::pipeline::{Binding, DescriptorSet, Pipeline, Spec};
 use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu};
 use anyhow::{bail, Result};
@@ -147,8 +147,11 @@ pub fn unused_grid_warning(s: &RenderSettings, grid_used: bool) -> Option<String
 /// as a uniform branch around it slowed every gather on lavapipe) and
 /// `GRID_SUB` (`shaders/visibility_layout.glsl`; the layout and the march's
 /// sub-cell samples). Shaders without a constant ignore its entry.
-pub fn specialization(s: &RenderSettings) -> [(u32, i32); 2] {
-    [(10, uses_voxels(s) as i32), (11, SUBCELLS.get(s) as i32)]
+pub fn specialization(s: &RenderSettings) -> [Spec; 2] {
+    [
+        Spec::bool("VOXEL_VISIBILITY", uses_voxels(s)),
+        Spec::int("GRID_SUB", SUBCELLS.get(s) as i32),
+    ]
 }
 
 /// Bytes of the grid of `s` (0 without `--visibility voxels`).
@@ -338,8 +341,10 @@ impl VisibilityGridPass {
             ],
         )?;
         let voxelization = |large: bool| {
-            let mut constants = specialization(setup.settings).to_vec();
-            constants.push((12, large as i32));
+            let constants = [
+                specialization(setup.settings)[1],
+                Spec::bool("LARGE", large),
+            ];
             Pipeline::compute(
                 setup.gpu,
                 if large {
@@ -360,7 +365,7 @@ impl VisibilityGridPass {
             "visibility_grid_levels.comp",
             &[setup.frame],
             std::mem::size_of::<VisibilityGridLevelPush>() as u32,
-            &specialization(setup.settings),
+            &specialization(setup.settings)[1..],
         )?;
         let (side, sub) = (GRID.get(setup.settings), SUBCELLS.get(setup.settings));
         Ok(Self {

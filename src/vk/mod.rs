@@ -9,6 +9,7 @@ pub mod profiler;
 pub mod reflect;
 pub mod resources;
 pub mod shaders;
+pub mod specialization;
 pub mod swapchain;
 mod upload;
 

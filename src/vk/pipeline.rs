@@ -4,31 +4,13 @@
 
 use super::context::Shared;
 pub use super::descriptors::{check_bindings, Binding, BindingInfo, DescriptorSet, Resource};
+pub use super::specialization::{check_specialization, Spec, SpecValue};
 // Re-exported: `tests/layouts.rs` reads the embedded SPIR-V by this path.
 pub use super::shaders::{shader_names, spirv};
 use super::Gpu;
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use std::sync::Arc;
-
-/// Map entries and data for 32-bit specialization constants (integers, bools,
-/// or a float's bits).
-fn specialization_data(constants: &[(u32, i32)]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
-    let entries = constants
-        .iter()
-        .enumerate()
-        .map(|(i, (id, _))| vk::SpecializationMapEntry {
-            constant_id: *id,
-            offset: (i * 4) as u32,
-            size: 4,
-        })
-        .collect();
-    let data = constants
-        .iter()
-        .flat_map(|(_, v)| v.to_ne_bytes())
-        .collect();
-    (entries, data)
-}
 
 fn shader_module(gpu: &Gpu, name: &str) -> Result<vk::ShaderModule> {
     let code = spirv(name)?;
@@ -108,8 +90,9 @@ pub struct GraphicsDesc<'a> {
     pub blend: Blend,
     /// Cull mode is set per draw (glTF `doubleSided`), so it is dynamic state.
     pub dynamic_cull: bool,
-    /// 32-bit specialization constants, by constant id (a float as its bits).
-    pub specialization: &'a [(u32, i32)],
+    /// The shaders' specialization constants, by name (every one they
+    /// declare, checked against their SPIR-V).
+    pub specialization: &'a [Spec],
 }
 
 impl Default for GraphicsDesc<'_> {
@@ -212,6 +195,11 @@ impl Pipeline {
             },
         )?;
         let layout = out.layout;
+        let constants = super::specialization::resolve(
+            desc.name,
+            &[desc.vertex_shader, desc.fragment_shader],
+            desc.specialization,
+        )?;
         let vs = shader_module(gpu, desc.vertex_shader)?;
         let fs = match shader_module(gpu, desc.fragment_shader) {
             Ok(fs) => fs,
@@ -220,21 +208,25 @@ impl Pipeline {
                 return Err(e);
             }
         };
-        let (spec_entries, spec_data) = specialization_data(desc.specialization);
-        let spec = vk::SpecializationInfo::default()
-            .map_entries(&spec_entries)
-            .data(&spec_data);
+        let spec: Vec<vk::SpecializationInfo> = constants
+            .iter()
+            .map(|c| {
+                vk::SpecializationInfo::default()
+                    .map_entries(&c.entries)
+                    .data(&c.data)
+            })
+            .collect();
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
                 .module(vs)
                 .name(c"main")
-                .specialization_info(&spec),
+                .specialization_info(&spec[0]),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
                 .module(fs)
                 .name(c"main")
-                .specialization_info(&spec),
+                .specialization_info(&spec[1]),
         ];
 
         let vertex_bindings = [vk::VertexInputBindingDescription {
@@ -343,7 +335,7 @@ impl Pipeline {
         shader: &str,
         sets: &[&DescriptorSet],
         push_constant_bytes: u32,
-        specialization: &[(u32, i32)],
+        specialization: &[Spec],
     ) -> Result<Self> {
         let mut out = Self::with_layout(
             gpu,
@@ -357,11 +349,11 @@ impl Pipeline {
             },
         )?;
         let layout = out.layout;
+        let constants = super::specialization::resolve(name, &[shader], specialization)?;
         let module = shader_module(gpu, shader)?;
-        let (spec_entries, spec_data) = specialization_data(specialization);
         let spec = vk::SpecializationInfo::default()
-            .map_entries(&spec_entries)
-            .data(&spec_data);
+            .map_entries(&constants[0].entries)
+            .data(&constants[0].data);
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)

@@ -142,3 +142,100 @@ pub fn bindings(words: &[u32]) -> Result<Vec<ShaderBinding>> {
     out.sort_by_key(|b| (b.set, b.binding));
     Ok(out)
 }
+
+/// The type of a specialization constant, as its SPIR-V declares it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpecKind {
+    Bool,
+    Int,
+    UInt,
+    Float,
+}
+
+/// One specialization constant of a shader: `layout(constant_id = ID) const
+/// TYPE NAME = ...;`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShaderSpecConstant {
+    pub id: u32,
+    pub name: String,
+    pub kind: SpecKind,
+}
+
+const OP_TYPE_BOOL: u32 = 20;
+const OP_TYPE_INT: u32 = 21;
+const OP_TYPE_FLOAT: u32 = 22;
+const OP_SPEC_CONSTANT_TRUE: u32 = 48;
+const OP_SPEC_CONSTANT_FALSE: u32 = 49;
+const OP_SPEC_CONSTANT: u32 = 50;
+const DECORATION_SPEC_ID: u32 = 1;
+
+/// Every scalar specialization constant `words` (a SPIR-V module) declares,
+/// by id: its name and type, so that hosts set them by name and a wrong type
+/// fails when the pipeline is made.
+pub fn spec_constants(words: &[u32]) -> Result<Vec<ShaderSpecConstant>> {
+    if words.len() < 5 || words[0] != 0x0723_0203 {
+        bail!("not a SPIR-V module");
+    }
+    let mut names: HashMap<u32, String> = HashMap::new();
+    let mut spec_ids: HashMap<u32, u32> = HashMap::new();
+    let mut scalar_types: HashMap<u32, SpecKind> = HashMap::new();
+    // (result id, result type id or None for a bool).
+    let mut constants: Vec<(u32, Option<u32>)> = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        let (op, count) = (words[i] & 0xffff, (words[i] >> 16) as usize);
+        if count == 0 || i + count > words.len() {
+            bail!("truncated SPIR-V instruction at word {i}");
+        }
+        let ins = &words[i..i + count];
+        match op {
+            OP_NAME if count >= 3 => {
+                names.insert(ins[1], string_at(&ins[2..]));
+            }
+            OP_DECORATE if count >= 4 && ins[2] == DECORATION_SPEC_ID => {
+                spec_ids.insert(ins[1], ins[3]);
+            }
+            OP_TYPE_BOOL if count >= 2 => {
+                scalar_types.insert(ins[1], SpecKind::Bool);
+            }
+            OP_TYPE_INT if count >= 4 => {
+                let kind = if ins[3] == 1 {
+                    SpecKind::Int
+                } else {
+                    SpecKind::UInt
+                };
+                scalar_types.insert(ins[1], kind);
+            }
+            OP_TYPE_FLOAT if count >= 3 => {
+                scalar_types.insert(ins[1], SpecKind::Float);
+            }
+            OP_SPEC_CONSTANT_TRUE | OP_SPEC_CONSTANT_FALSE if count >= 3 => {
+                constants.push((ins[2], None));
+            }
+            OP_SPEC_CONSTANT if count >= 4 => constants.push((ins[2], Some(ins[1]))),
+            _ => {}
+        }
+        i += count;
+    }
+    let mut out = Vec::new();
+    for (id, ty) in constants {
+        // Constants folded from others (`OpSpecConstantOp`) have no SpecId.
+        let Some(&spec_id) = spec_ids.get(&id) else {
+            continue;
+        };
+        let kind = match ty {
+            None => SpecKind::Bool,
+            Some(t) => match scalar_types.get(&t) {
+                Some(k) => *k,
+                None => bail!("specialization constant {spec_id} has a type that is not a scalar"),
+            },
+        };
+        out.push(ShaderSpecConstant {
+            id: spec_id,
+            name: names.get(&id).cloned().unwrap_or_default(),
+            kind,
+        });
+    }
+    out.sort_by_key(|c| c.id);
+    Ok(out)
+}

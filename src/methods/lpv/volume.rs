@@ -27,7 +27,7 @@ use crate::passes::{
     begin_rendering, Attachments, ComputePass, INDIRECT_COMPUTE, INDIRECT_GRAPHICS,
 };
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, Blend, GraphicsDesc, PassPipeline};
+use crate::vk::pipeline::{Binding, Blend, GraphicsDesc, PassPipeline, Spec};
 use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu, Image, ImageDesc};
 use anyhow::{bail, Result};
@@ -131,7 +131,10 @@ impl Lpv {
 
         let (t, samplers) = (setup.targets, setup.samplers);
         let nearest = samplers.nearest;
-        let spec = [(0, n as i32), (1, c as i32)];
+        let spec = [
+            Spec::int("LPV_SIZE", n as i32),
+            Spec::int("LPV_CASCADES", c as i32),
+        ];
         let inject = PassPipeline::graphics(
             gpu,
             setup.frame,
@@ -146,7 +149,11 @@ impl Lpv {
                 fragment_shader: "lpv_inject.frag",
                 color_formats: &[SH_FORMAT; 3],
                 blend: Blend::Additive,
-                specialization: &[spec[0], spec[1], (2, layout.vpl_level as i32)],
+                specialization: &[
+                    spec[0],
+                    spec[1],
+                    Spec::int("LPV_LEVEL", layout.vpl_level as i32),
+                ],
                 ..Default::default()
             },
         )?;
@@ -169,9 +176,9 @@ impl Lpv {
                     specialization: &[
                         spec[0],
                         spec[1],
-                        (2, from_gbuffer as i32),
-                        (3, layout.vpl_level as i32),
-                        (4, layout.gbuffer_stride as i32),
+                        Spec::bool("FROM_GBUFFER", from_gbuffer),
+                        Spec::int("LPV_LEVEL", layout.vpl_level as i32),
+                        Spec::int("LPV_STRIDE", layout.gbuffer_stride as i32),
                     ],
                     ..Default::default()
                 },
@@ -195,7 +202,7 @@ impl Lpv {
             "lpv_propagate.comp",
             &[variant(0), variant(1)],
             0,
-            &[spec[0], spec[1], (2, layout.occlusion as i32)],
+            &[spec[0], spec[1], Spec::bool("OCCLUSION", layout.occlusion)],
         )?;
         let lookup = PassPipeline::graphics(
             gpu,
