@@ -61,10 +61,12 @@ impl RsmGather {
             setup,
             "rsm-gather",
             INDIRECT_GRAPHICS,
-            "rsm_gather.frag",
+            (
+                "rsm_gather.frag",
+                &crate::passes::visibility_grid::specialization(setup.settings),
+            ),
             &full_resolution_bindings(setup),
             8,
-            &crate::passes::visibility_grid::specialization(setup.settings),
             |t| &t.indirect,
         )?))
     }

@@ -18,10 +18,9 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         setup,
         "composite",
         GRAPHICS,
-        "composite.frag",
+        ("composite.frag", &[]),
         &bindings,
         0,
-        &[],
         |t| &t.final_radiance,
     )
 }

@@ -19,10 +19,9 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         setup,
         "direct",
         GRAPHICS,
-        "direct_light.frag",
+        ("direct_light.frag", &[]),
         &bindings,
         0,
-        &[],
         |t| &t.direct,
     )
 }

@@ -314,15 +314,15 @@ pub struct FullscreenPass {
 }
 
 impl FullscreenPass {
+    /// `shader`: the fragment shader and its specialization constants;
     /// `push_constant_bytes` of push constants for `record_with`.
     pub fn new(
         setup: &Setup,
         name: &'static str,
         kind: PassKind,
-        fragment_shader: &str,
+        (fragment_shader, specialization): (&str, &[Spec]),
         bindings: &[Binding],
         push_constant_bytes: u32,
-        specialization: &[Spec],
         output: fn(&Targets) -> &Image,
     ) -> Result<Self> {
         let pipeline = PassPipeline::graphics(

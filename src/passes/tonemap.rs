@@ -18,10 +18,9 @@ pub fn new(setup: &Setup) -> Result<FullscreenPass> {
         setup,
         "tonemap",
         GRAPHICS,
-        "tonemap.frag",
+        ("tonemap.frag", &[]),
         &bindings,
         0,
-        &[],
         |t| &t.display,
     )
 }
