@@ -1,9 +1,13 @@
-//! Compiles every GLSL stage in `shaders/` to SPIR-V with glslang and embeds the
-//! result in the binary (see `src/vk/shaders.rs`), so `isr` runs from any directory.
+//! Compiles every GLSL stage in `shaders/` and its folders (`shaders/hisr/`,
+//! one per method or module that has shaders of its own) to SPIR-V with
+//! glslang and embeds the result in the binary (see `src/vk/shaders.rs`), so
+//! `isr` runs from any directory. A shader is named by its path under
+//! `shaders/` (`hisr/cut.comp`).
 //!
 //! Files ending in `.vert`, `.frag` and `.comp` are compiled; `.glsl` files are
-//! headers, reached only through `#include "..."` (resolved relative to `shaders/`).
-//! A compile error fails the build and names the file and line.
+//! headers, reached only through `#include "..."` (resolved relative to
+//! `shaders/`, so `#include "hisr/hisr.glsl"` reads the same file from any
+//! folder). A compile error fails the build and names the file and line.
 
 use glslang::error::GlslangError;
 use glslang::include::{IncludeHandler, IncludeResult, IncludeType};
@@ -52,16 +56,29 @@ fn readable_log(file: &str, err: &GlslangError) -> String {
         .replace("WARNING: 0:", &format!("WARNING: {file}:"))
 }
 
+/// Every file in `dir` and its folders.
+fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
+    let entries =
+        std::fs::read_dir(dir).unwrap_or_else(|e| panic!("reading {}: {e}", dir.display()));
+    for entry in entries {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            println!("cargo:rerun-if-changed={}", path.display());
+            files_under(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+}
+
 fn main() {
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
     let shader_dir = manifest.join("shaders");
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     println!("cargo:rerun-if-changed=shaders");
 
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(&shader_dir)
-        .expect("shaders/ directory is missing")
-        .map(|e| e.unwrap().path())
-        .collect();
+    let mut entries = Vec::new();
+    files_under(&shader_dir, &mut entries);
     entries.sort();
 
     let compiler = Compiler::acquire().expect("glslang failed to initialise");
@@ -85,7 +102,12 @@ fn main() {
         let Some(stage) = stage_of(path) else {
             continue;
         };
-        let name = path.file_name().unwrap().to_str().unwrap().to_string();
+        let name = path
+            .strip_prefix(&shader_dir)
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .replace('\\', "/");
         let display = format!("shaders/{name}");
         let source = std::fs::read_to_string(path).unwrap();
         let source = ShaderSource::from(source);
@@ -104,7 +126,7 @@ fn main() {
         match result {
             Ok(words) => {
                 let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-                let spv = out_dir.join(format!("{name}.spv"));
+                let spv = out_dir.join(format!("{}.spv", name.replace('/', "__")));
                 std::fs::write(&spv, bytes).unwrap();
                 writeln!(
                     table,

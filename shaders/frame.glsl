@@ -9,6 +9,6 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms u; };
 layout(set = 0, binding = 1) uniform Run { RunUniforms run; };
 layout(set = 0, binding = 2, std430) readonly buffer Transforms { InstanceTransform transforms[]; };
 // Binding 3, the voxel visibility grid, is declared where it is used: read by
-// the patch formula (visibility.glsl), written by visibility_grid.comp.
+// the patch formula (voxel_grid/march.glsl), written by voxel_grid/voxelize.comp.
 
 #endif

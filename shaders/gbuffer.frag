@@ -12,7 +12,7 @@ layout(location = 2) in vec2 in_uv;
 
 layout(location = 0) out vec4 out_position;  // xyz: world (m); w: view depth (m), 0 = background
 layout(location = 1) out vec4 out_normal;    // xyz: unit world normal facing the camera; w: view depth again,
-                                             // times u.normal_depth_scale (16-bit, for geometry_level_one.frag)
+                                             // times u.normal_depth_scale (16-bit, for multires/geometry_level_one.frag)
 layout(location = 2) out vec4 out_albedo;    // rgb: linear diffuse albedo
 
 void main() {

@@ -109,10 +109,10 @@ float validity_reach(vec3 p) {
     return distance(p, u.light_position);
 }
 
-// HISR (gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
+// HISR (multires/gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
 // (mean position pj, node xy at depth d: 2^d x 2^d patches across the RSM)
 // iff |V_ij|^2 <= 4^k * hisr_bound(...), k its levels above the finest.
-// t_finest is T of gather.frag's derivation (run.hisr_threshold), which is
+// t_finest is T of multires/gather.frag's derivation (run.hisr_threshold), which is
 // dw_talk (1 - tau) / (pi tau) with the talk's texel solid angle
 // dw_talk = 2 pi / (3 R^2).
 //

@@ -72,13 +72,13 @@ struct RunUniforms {
     int isr_base_level;           // RSM quadtree level (mip) of the base
     // HISR (docs/algorithm.md section 4.3).
     float hisr_threshold;         // T at the finest level, computed once on the host
-                                  // (gather.frag derives the test)
+                                  // (multires/gather.frag derives the test)
     int hisr_start_depth;         // traversal starts from 2^s x 2^s patches
     int hisr_max_depth;           // and subdivides down to 2^d x 2^d
     // Restricted splats.
     float splat_threshold;        // irradiance bound, W/m^2
     // HISR's tau and what it is relative to (docs/algorithm.md section 4.3;
-    // hisr_reach in hisr.glsl).
+    // hisr_reach in hisr/hisr.glsl).
     float hisr_tau;               // --tau
     int hisr_tau_mode;            // HISR_TAU_*
     // Indirect visibility (docs/algorithm.md section 5, "Voxel visibility";
@@ -91,7 +91,7 @@ struct RunUniforms {
 
 // RunUniforms::visibility: which visibility term patch_irradiance applies (vpl.glsl).
 const int VISIBILITY_NONE = 0;    // none: every patch lights every receiver it faces
-const int VISIBILITY_VOXELS = 1;  // the segment marched through the occupancy grid (visibility.glsl)
+const int VISIBILITY_VOXELS = 1;  // the segment marched through the occupancy grid (voxel_grid/march.glsl)
 
 // RunUniforms::patch_kernel (docs/algorithm.md section 2.6): a patch of
 // several RSM texels evaluated at its centre with the disc form factor, or
@@ -132,15 +132,15 @@ const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR 
 int patch_level(int k, float state) { return state == PATCH_INVALID ? -k : k; }
 
 // HISR splits an invalid patch while its bound could exceed tau times this
-// (gather.frag, docs/algorithm.md section 4.3).
+// (multires/gather.frag, docs/algorithm.md section 4.3).
 const float HISR_INVALID_TAU_SCALE = 0.01;
 
 // HISR's per-tile cuts (docs/algorithm.md section 4.4) come in
 // HISR_CUT_LEVELS chained levels: level c has tiles of 2^(K + c) pixels a
 // side; the coarsest is cut from the start depth, each finer one from its
-// parent tile's "traverse" entries. Layout of the buffer (hisr_cut.comp
-// writes it, gather.frag reads it): this header, then per level a count per
-// tile, then per level `capacity` entries per tile (hisr.glsl: packed indices
+// parent tile's "traverse" entries. Layout of the buffer (hisr/cut.comp
+// writes it, multires/gather.frag reads it): this header, then per level a count per
+// tile, then per level `capacity` entries per tile (hisr/hisr.glsl: packed indices
 // for evaluate entries, cut_entry for traverse entries):
 // a tile's "evaluate" entries from the front of its range, its "traverse"
 // entries from the back. A count holds the evaluate entries in bits 0-15 and
@@ -148,10 +148,10 @@ const float HISR_INVALID_TAU_SCALE = 0.01;
 // uints after the header. With the voxel grid and shared tile visibility,
 // then per finest tile one word per slot of the three levels (coarsest
 // level first; evaluate entries, and the finest level's traverse entries):
-// the entry's visibility from the tile's four corner pixels, packUnorm4x8 (hisr_visibility.comp writes it, gather.frag
+// the entry's visibility from the tile's four corner pixels, packUnorm4x8 (hisr/visibility.comp writes it, multires/gather.frag
 // interpolates it); then per finest tile a bit per slot, set where every
 // receiver marches the entry itself (the corners disagree or none has
-// geometry: hisr_visibility.comp), so the gather finds the entries of each
+// geometry: hisr/visibility.comp), so the gather finds the entries of each
 // kind a word of 32 slots at a time; then (with refinement) the tile's
 // further points, their visibilities and march bits (HisrCutHeader.points).
 const int HISR_CUT_LEVELS = 3;
@@ -159,17 +159,17 @@ struct HisrCutHeader {
     uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
                                    // level K + c; w: offset of its counts
     uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: of the
-                                   // finest tiles' boxes (8 floats each, hisr_cut.comp)
+                                   // finest tiles' boxes (8 floats each, hisr/cut.comp)
     uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
     uvec4 visibility;              // x: offset of the entries' corner visibilities
-                                   // (hisr_visibility.comp), 0 without them; y: their slots
+                                   // (hisr/visibility.comp), 0 without them; y: their slots
                                    // per finest tile (the capacities' sum); z: offset of
                                    // the march bits; w: their words per finest tile
     uvec4 points;                  // x: offset of the tile points' pixels (4 words per
                                    // finest tile, (y << 16) | x, ~0u past the last);
                                    // y: of their visibilities, as the corners' (0 without);
                                    // z: of their receivers' march bits, as the corners'
-                                   // (tile_points.glsl)
+                                   // (hisr/tile_points.glsl)
 };
 
 // A tile whose cut did not fit: its fragments traverse from the roots.
@@ -178,7 +178,7 @@ const uint HISR_CUT_OVERFLOW = 4294967295u;
 // RunUniforms::hierarchy_flags bits.
 const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
 // (Bit 2 is free: nearest or interpolated upsampling is a specialisation
-// constant of upsample.comp.)
+// constant of multires/upsample.comp.)
 const int HIERARCHY_STENCIL_OFF = 4;   // gather every texel, mask afterwards
 
 // Geometry-mip flag bits (image geo_flags).
@@ -195,7 +195,7 @@ struct MaterialGpu {
     int pad2;
 };
 
-// Push constants of one dispatch of pass visibility-grid (visibility_grid.comp):
+// Push constants of one dispatch of pass visibility-grid (voxel_grid/voxelize.comp):
 // a range of one instance's triangles, one invocation each.
 struct VisibilityGridPush {
     uint first_index;     // the instance's mesh's first index
@@ -206,7 +206,7 @@ struct VisibilityGridPush {
 };
 
 // Push constants of one dispatch of pass visibility-grid's OR-levels
-// (visibility_grid_levels.comp).
+// (voxel_grid/levels.comp).
 struct VisibilityGridLevelPush {
     int level;  // the level it reads; it writes level + 1
 };
@@ -217,7 +217,7 @@ struct DrawPush {
     uint material;  // index into the materials
 };
 
-// Push constants of the viewer's present pass (present.frag): the frame's
+// Push constants of the viewer's present pass (viewer/present.frag): the frame's
 // image scaled into the window, aspect kept, the rest letterboxed.
 struct PresentPush {
     ivec4 rect;        // xy: the image's top-left corner in the window (pixels); zw: its size
@@ -233,7 +233,7 @@ const int PRESENT_VIEW_FINAL = 0;     // the tonemapped frame (the PNG of `isr r
 const int PRESENT_VIEW_INDIRECT = 1;  // albedo / pi * E alone, times the exposure
 const int PRESENT_VIEW_HOST = 2;      // an sRGB image the host uploaded (levels, vpl-count)
 
-// Push constants of the viewer's text overlay (overlay_text.vert/.frag): a
+// Push constants of the viewer's text overlay (viewer/overlay_text.vert/.frag): a
 // grid of 8x8 glyphs; each cell of the text buffer is `char | colour << 8`.
 struct OverlayPush {
     ivec4 rect;    // xy: the grid's top-left corner (pixels); z, w: columns, rows

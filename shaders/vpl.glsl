@@ -1,7 +1,7 @@
 // Light patches and their contribution to a receiver (docs/algorithm.md section 2).
 #ifndef VPL_GLSL
 #define VPL_GLSL
-#include "visibility.glsl"
+#include "voxel_grid/march.glsl"
 
 // Whether the march is compiled in at all (src/passes/visibility_grid.rs
 // sets it from --visibility): a uniform branch around it cost lavapipe
@@ -25,9 +25,9 @@ layout(constant_id = 20) const bool VOXEL_VISIBILITY = false;
 // the voxel grid's 0 to 1 with --visibility voxels; docs/algorithm.md
 // section 5, "Voxel visibility"). The march runs for every pair, not only
 // where the rest is not 0, so that a list's fragments march together
-// (one march's loop at a time: lavapipe's loop limit, visibility.glsl).
+// (one march's loop at a time: lavapipe's loop limit, voxel_grid/march.glsl).
 // patch_unshadowed is E without V_ij, for a caller that finds V_ij itself
-// (HISR's tile-shared visibility, gather.frag).
+// (HISR's tile-shared visibility, multires/gather.frag).
 vec3 patch_unshadowed(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
     vec3 v = xj - xi;
     float d2 = dot(v, v);

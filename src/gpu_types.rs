@@ -171,7 +171,7 @@ pub const CHOSEN_PATCHES_HEADER: usize = 16;
 pub const HISR_CUT_LEVELS: usize = 3;
 
 /// `HisrCutHeader` (std430): the head of HISR's per-tile cut buffer
-/// (`shaders/hisr_cut.comp`): per level, tiles per row and column, tile level
+/// (`shaders/hisr/cut.comp`): per level, tiles per row and column, tile level
 /// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
 /// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
 /// `entries[0]` (8 floats a tile); with shared tile visibility, the
@@ -180,7 +180,7 @@ pub const HISR_CUT_LEVELS: usize = 3;
 /// words per finest tile, and the further tile points' pixels at
 /// `points[0]` (4 words per finest tile), their visibilities at `points[1]`
 /// and march bits at `points[2]`, laid out as the corners'
-/// (`shaders/hisr_visibility.comp`); offsets in `u32`s after the header.
+/// (`shaders/hisr/visibility.comp`); offsets in `u32`s after the header.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct HisrCutHeader {

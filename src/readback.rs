@@ -308,7 +308,7 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
             regions.push(Region::mip(format!("geo_flags/{l}"), &m.geo_flags, l - 1));
         }
     }
-    // Level 0 of the mean and normal is the G-buffer (`shaders/geo_levels.glsl`).
+    // Level 0 of the mean and normal is the G-buffer (`shaders/multires/geo_levels.glsl`).
     regions.push(Region::mip("gbuffer_position", &t.gbuffer_position, 0));
     regions.push(Region::mip("gbuffer_normal", &t.gbuffer_normal, 0));
     let rsm_levels = t.rsm_position.mips;

@@ -5,7 +5,7 @@
 //!
 //! `--visibility exact` (`passes::visibility_grid::VISIBILITY`) is the limit,
 //! for the dense `reference`: its gather
-//! (every RSM texel a VPL, `shaders/rsm_gather.frag`'s `patch_irradiance`)
+//! (every RSM texel a VPL, `shaders/rsm_gather/gather.frag`'s `patch_irradiance`)
 //! run on the CPU with one ray per (receiver, VPL) through the path tracer's
 //! BVH (`pathtrace::Occluders`). Against the path-traced truth it is the
 //! VPL model's own error (texel-sized VPLs, the disc term `A_j`); the

@@ -123,7 +123,11 @@ fn frame_uniforms_match_shared_glsl() {
 
 #[test]
 fn run_uniforms_match_shared_glsl() {
-    for shader in ["direct_light.frag", "gather.frag", "upsample.comp"] {
+    for shader in [
+        "direct_light.frag",
+        "multires/gather.frag",
+        "multires/upsample.comp",
+    ] {
         check!(shader, RunUniforms, "RunUniforms", patch_kernel: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
@@ -166,7 +170,7 @@ fn instance_transform_matches_shared_glsl() {
 
 #[test]
 fn light_patch_matches_shared_glsl() {
-    check!("isr_select.comp", LightPatch, "LightPatch", flux: 16, [
+    check!("isr/select.comp", LightPatch, "LightPatch", flux: 16, [
         position_area => "position_area",
         normal => "normal",
         flux => "flux",
@@ -175,7 +179,11 @@ fn light_patch_matches_shared_glsl() {
 
 #[test]
 fn hisr_cut_header_matches_shared_glsl() {
-    for shader in ["hisr_cut.comp", "gather.frag", "hisr_visibility.comp"] {
+    for shader in [
+        "hisr/cut.comp",
+        "multires/gather.frag",
+        "hisr/visibility.comp",
+    ] {
         check!(shader, HisrCutHeader, "HisrCutHeader", points: 16, [
             tiles => "tiles",
             entries => "entries",
@@ -207,7 +215,7 @@ fn draw_push_matches_shared_glsl() {
 
 #[test]
 fn visibility_grid_push_matches_shared_glsl() {
-    check!("visibility_grid.comp", VisibilityGridPush, "VisibilityGridPush", triangles: 4, [
+    check!("voxel_grid/voxelize.comp", VisibilityGridPush, "VisibilityGridPush", triangles: 4, [
         first_index => "first_index",
         vertex_offset => "vertex_offset",
         instance => "instance",
@@ -218,7 +226,7 @@ fn visibility_grid_push_matches_shared_glsl() {
 
 #[test]
 fn visibility_grid_level_push_matches_shared_glsl() {
-    check!("visibility_grid_levels.comp", VisibilityGridLevelPush, "VisibilityGridLevelPush", level: 4, [
+    check!("voxel_grid/levels.comp", VisibilityGridLevelPush, "VisibilityGridLevelPush", level: 4, [
         level => "level",
     ]);
 }
@@ -226,7 +234,7 @@ fn visibility_grid_level_push_matches_shared_glsl() {
 #[test]
 fn viewer_pushes_match_shared_glsl() {
     use isr::gpu_types::{OverlayPush, PresentPush};
-    check!("present.frag", PresentPush, "PresentPush", pad1: 4, [
+    check!("viewer/present.frag", PresentPush, "PresentPush", pad1: 4, [
         rect => "rect",
         letterbox => "letterbox",
         view => "view",
@@ -234,7 +242,7 @@ fn viewer_pushes_match_shared_glsl() {
         pad0 => "pad0",
         pad1 => "pad1",
     ]);
-    for shader in ["overlay_text.vert", "overlay_text.frag"] {
+    for shader in ["viewer/overlay_text.vert", "viewer/overlay_text.frag"] {
         check!(shader, OverlayPush, "OverlayPush", target: 16, [
             rect => "rect",
             target => "target",
@@ -309,16 +317,28 @@ fn flag_constants_match_shared_glsl() {
 
 #[test]
 fn every_shader_in_the_directory_is_embedded() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let embedded: Vec<&str> = isr::vk::pipeline::shader_names().collect();
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let name = entry.unwrap().file_name().into_string().unwrap();
-        if !name.ends_with(".glsl") {
-            assert!(
-                embedded.contains(&name.as_str()),
-                "{name} was not compiled into the binary"
-            );
+    fn walk(dir: &std::path::Path, root: &std::path::Path, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, root, out);
+            } else {
+                let name = path.strip_prefix(root).unwrap().to_str().unwrap();
+                out.push(name.replace('\\', "/"));
+            }
         }
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut files = vec![];
+    walk(&root, &root, &mut files);
+    let embedded: Vec<&str> = isr::vk::pipeline::shader_names().collect();
+    // In folders too (`hisr/cut.comp`).
+    assert!(files.iter().any(|f| f.contains('/')), "{files:?}");
+    for name in files.iter().filter(|n| !n.ends_with(".glsl")) {
+        assert!(
+            embedded.contains(&name.as_str()),
+            "{name} was not compiled into the binary"
+        );
     }
 }
 
@@ -348,8 +368,8 @@ mod bindings {
                 name: "Transforms",
                 kind: Kind::StorageBuffer,
             },
-            // Read by the patch formula (visibility.glsl), written by
-            // visibility_grid.comp.
+            // Read by the patch formula (voxel_grid/march.glsl), written by
+            // voxel_grid/voxelize.comp.
             BindingInfo {
                 name: "VisibilityGrid",
                 kind: Kind::StorageBuffer,
@@ -470,7 +490,7 @@ fn every_specialization_constant_has_one_name_id_and_type() {
 mod specialization {
     use isr::vk::pipeline::{check_specialization, Spec};
 
-    const SHADERS: [&str; 2] = ["layered.vert", "stencil_refine.frag"];
+    const SHADERS: [&str; 2] = ["multires/layered.vert", "multires/stencil_refine.frag"];
 
     #[test]
     fn the_constants_the_shaders_declare_pass() {

@@ -1,5 +1,5 @@
 //! The voxel grid's voxelization (pass `visibility-grid`,
-//! `shaders/visibility_grid.comp`; docs/algorithm.md section 5, "Voxel
+//! `shaders/voxel_grid/voxelize.comp`; docs/algorithm.md section 5, "Voxel
 //! visibility") against a separating-axis test written here, on triangles
 //! of every size and orientation: the large ones that whole workgroups
 //! share, the small ones that one invocation marks, an instance stretched

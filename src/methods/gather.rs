@@ -1,6 +1,6 @@
 //! Pass `gather`: stenciled gathering into the multiresolution buffer
 //! (docs/algorithm.md section 3, step 6). One instanced draw over every layer
-//! (`shaders/layered.vert` + `shaders/gather.frag`), stencil test EQUAL 1
+//! (`shaders/multires/layered.vert` + `shaders/multires/gather.frag`), stencil test EQUAL 1
 //! before the shader. Reads the geometry mips and the RSM quadtree (and the
 //! ISR list); writes the illumination buffer and the evaluation counts
 //! (barriers: `MultiresBuffer::fill_layers`).
@@ -73,8 +73,8 @@ impl GatherPass {
             ],
             GraphicsDesc {
                 name: "gather",
-                vertex_shader: "layered.vert",
-                fragment_shader: "gather.frag",
+                vertex_shader: "multires/layered.vert",
+                fragment_shader: "multires/gather.frag",
                 color_formats: &[m.illumination.format, m.evaluations.format],
                 stencil_format: if stencil {
                     m.stencil.format

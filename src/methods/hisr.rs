@@ -1,7 +1,7 @@
 //! Method `hisr` (Hierarchical image-space radiosity, docs/algorithm.md
 //! section 4): every eye-space patch traverses the RSM quadtree itself,
 //! subdividing light patches whose contribution could exceed tau. The
-//! traversal is in `shaders/gather.frag` (`traverse`, with the derivation of
+//! traversal is in `shaders/multires/gather.frag` (`traverse`, with the derivation of
 //! the bound) and reads the quadtree packed into one buffer by the pass
 //! below, starting from its eye-space tile's shared cut (`hisr-cut`); this
 //! module declares the method and its parameters, and makes its passes.
@@ -32,7 +32,7 @@ use gpu_allocator::MemoryLocation;
 
 pub const KEY: Method = Method::new("hisr");
 
-/// The deepest tree the packing addresses (`cut_entry` in `shaders/hisr.glsl`
+/// The deepest tree the packing addresses (`cut_entry` in `shaders/hisr/hisr.glsl`
 /// keeps 12 bits per coordinate): an RSM of 4096.
 const MAX_TREE_DEPTH: f64 = 12.0;
 
@@ -181,7 +181,7 @@ pub fn shares_visibility(s: &RenderSettings) -> bool {
 
 /// T at the finest level for `tau` given as a fraction of the light's peak
 /// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2)
-/// (`shaders/gather.frag` derives the test; this is the one place T is
+/// (`shaders/multires/gather.frag` derives the test; this is the one place T is
 /// computed, for the run uniforms).
 pub fn subdivision_threshold(tau: f32, rsm_resolution: u32) -> f32 {
     let r2 = rsm_resolution as f64 * rsm_resolution as f64;
@@ -307,7 +307,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     v
 }
 
-/// Method `hisr`: pass `light-tree-pack` (`shaders/light_tree_pack.comp`)
+/// Method `hisr`: pass `light-tree-pack` (`shaders/hisr/tree_pack.comp`)
 /// copies the RSM quadtree's nodes down to the max depth into one buffer, root
 /// first; with tiles (`--hisr-tile-level`), pass `hisr-cut` finds each
 /// eye-space tile's shared cut; then the gather traverses per fragment.
@@ -322,7 +322,7 @@ fn make(setup: &Setup) -> Result<MultiresMethod> {
     let pack = PatchListPass::new(
         setup,
         PatchList::PackedTree,
-        ("light-tree-pack", "light_tree_pack.comp", "LightTree"),
+        ("light-tree-pack", "hisr/tree_pack.comp", "LightTree"),
         nodes,
         extent,
     )?;
@@ -383,7 +383,7 @@ impl LightSpacePass for HisrLightPass {
     }
 }
 
-/// Pass `hisr-cut` (`shaders/hisr_cut.comp`, docs/algorithm.md section 4.4):
+/// Pass `hisr-cut` (`shaders/hisr/cut.comp`, docs/algorithm.md section 4.4):
 /// one dispatch for the finest tiles' boxes of G-buffer positions, then one
 /// per chained level, coarsest first, one invocation per eye-space tile.
 /// Reads the G-buffer positions, the packed tree, the boxes and the coarser
@@ -391,7 +391,7 @@ impl LightSpacePass for HisrLightPass {
 struct CutPass {
     boxes: ComputePass,
     pass: ComputePass,
-    /// Pass `hisr-visibility` (`shaders/hisr_visibility.comp`), with shared
+    /// Pass `hisr-visibility` (`shaders/hisr/visibility.comp`), with shared
     /// visibility.
     visibility: Option<ComputePass>,
     /// `--hisr-shared-refine`, for the gather.
@@ -422,7 +422,7 @@ impl CutPass {
             ComputePass::new(
                 setup,
                 "hisr-cut",
-                "hisr_cut.comp",
+                "hisr/cut.comp",
                 std::slice::from_ref(&bindings),
                 push_bytes,
                 &[crate::vk::pipeline::Spec::bool("BOXES", boxes)],
@@ -432,7 +432,7 @@ impl CutPass {
             true => Some(ComputePass::new(
                 setup,
                 "hisr-visibility",
-                "hisr_visibility.comp",
+                "hisr/visibility.comp",
                 &[vec![
                     Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                     Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),

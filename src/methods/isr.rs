@@ -3,7 +3,7 @@
 //! level, compacted on the GPU into one list that every eye-space patch
 //! gathers from (`methods::gather`).
 //!
-//! Pass `isr-select`: `shaders/isr_select.comp`, one dispatch over the base
+//! Pass `isr-select`: `shaders/isr/select.comp`, one dispatch over the base
 //! level with an atomic append (a [`PatchListPass`]). Reads the RSM quadtree;
 //! writes the chosen list.
 
@@ -94,7 +94,7 @@ impl Descriptor for IsrMethod {
         let select = PatchListPass::new(
             setup,
             PatchList::IsrChosen,
-            ("isr-select", "isr_select.comp", "ChosenPatches"),
+            ("isr-select", "isr/select.comp", "ChosenPatches"),
             base_texels(setup.settings),
             base_extent,
         )?;

@@ -351,7 +351,7 @@ pub trait IndirectMethod {
     }
 
     /// HISR's packed light tree (`CHOSEN_PATCHES_HEADER`, then a `LightPatch`
-    /// per quadtree node, root first; see `shaders/light_tree_pack.comp`).
+    /// per quadtree node, root first; see `shaders/hisr/tree_pack.comp`).
     fn packed_light_tree(&self) -> Option<&Buffer> {
         None
     }

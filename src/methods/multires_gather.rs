@@ -1,7 +1,7 @@
 //! Method `multires-gather` (docs/algorithm.md sections 3 and 4): every patch
 //! of the multiresolution buffer gathers the N regular VPLs (one level of the
 //! RSM quadtree), with the stencil rejecting non-patches before the shader.
-//! Pass `vpl-list` (`shaders/vpl_list.comp`) writes the N VPLs into one
+//! Pass `vpl-list` (`shaders/regular_vpls/list.comp`) writes the N VPLs into one
 //! buffer once per frame, which the gather then loops over as Basic ISR's
 //! list; the other passes are those of [`MultiresMethod`].
 
@@ -47,7 +47,7 @@ impl Descriptor for MultiresGatherMethod {
         let list = PatchListPass::new(
             setup,
             PatchList::RegularVpls,
-            ("vpl-list", "vpl_list.comp", "VplList"),
+            ("vpl-list", "regular_vpls/list.comp", "VplList"),
             v.count as u64,
             vk::Extent2D {
                 width: v.side,

@@ -2,7 +2,7 @@
 //! 2009): every regular VPL splats into every stencilled texel of the
 //! multiresolution buffer, additively; then the same upsampling. This is what
 //! the paper's stenciled gathering replaced.
-//! Pass `splat`: `shaders/multires_splat.vert` + `shaders/multires_splat.frag`,
+//! Pass `splat`: `shaders/multires_splat/splat.vert` + `shaders/multires_splat/splat.frag`,
 //! one instanced draw of N x (L + 1) quads, stencil EQUAL 1 before the shader.
 //! Reads the geometry mips and the RSM quadtree; writes the illumination
 //! buffer and the evaluation counts (barriers: `MultiresBuffer::fill_layers`).
@@ -80,8 +80,8 @@ impl MultiresSplatPass {
             ],
             GraphicsDesc {
                 name: "splat",
-                vertex_shader: "multires_splat.vert",
-                fragment_shader: "multires_splat.frag",
+                vertex_shader: "multires_splat/splat.vert",
+                fragment_shader: "multires_splat/splat.frag",
                 color_formats: &[m.illumination.format, m.evaluations.format],
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::EQUAL_ONE),

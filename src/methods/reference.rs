@@ -12,7 +12,7 @@
 //! would measure nothing. The reference is a ground truth, not a real-time
 //! method; its time is informational.
 //!
-//! `shaders/rsm_gather.frag` with additive blending. Reads the G-buffer and
+//! `shaders/rsm_gather/gather.frag` with additive blending. Reads the G-buffer and
 //! RSM; writes `indirect` (barriers below).
 
 use super::rsm_gather::full_resolution_bindings;
@@ -100,7 +100,7 @@ impl Reference {
             &full_resolution_bindings(setup),
             GraphicsDesc {
                 name: "reference",
-                fragment_shader: "rsm_gather.frag",
+                fragment_shader: "rsm_gather/gather.frag",
                 push_constant_bytes: 8,
                 color_formats: &[format],
                 blend: Blend::Additive,

@@ -1,6 +1,6 @@
 //! Method `rsm-gather` (docs/algorithm.md section 5, Dachsbacher & Stamminger
 //! 2005): every full-resolution pixel gathers the N regular VPLs. Pass
-//! `rsm-gather`, `shaders/rsm_gather.frag` (barriers: `FullscreenPass::record`).
+//! `rsm-gather`, `shaders/rsm_gather/gather.frag` (barriers: `FullscreenPass::record`).
 //! Reads the G-buffer and the RSM quadtree; writes `indirect`.
 
 use super::vpls::RegularVpls;
@@ -40,7 +40,7 @@ impl Descriptor for RsmGatherMethod {
     }
 }
 
-/// The bindings `rsm_gather.frag` and the splat shaders share: G-buffer
+/// The bindings `rsm_gather/gather.frag` and the splat shaders share: G-buffer
 /// position and normal, RSM quadtree position, normal and flux.
 pub fn full_resolution_bindings<'a>(setup: &Setup<'a>) -> Vec<Binding<'a>> {
     let (t, s) = (setup.targets, setup.samplers);
@@ -62,7 +62,7 @@ impl RsmGather {
             "rsm-gather",
             INDIRECT_GRAPHICS,
             (
-                "rsm_gather.frag",
+                "rsm_gather/gather.frag",
                 &crate::passes::visibility_grid::specialization(setup.settings),
             ),
             &full_resolution_bindings(setup),

@@ -2,7 +2,7 @@
 //! 5): each of the N regular VPLs draws a quad, full screen or bounded to
 //! where its contribution can exceed `--splat-threshold` (D&S 2006), and its
 //! fragments add that VPL's irradiance into the float target (blend ONE + ONE).
-//! Pass `rsm-splat`: `shaders/vpl_splat.vert` + `shaders/vpl_splat.frag`, one
+//! Pass `rsm-splat`: `shaders/rsm_splat/splat.vert` + `shaders/rsm_splat/splat.frag`, one
 //! instanced draw (instance = VPL). Reads the G-buffer and RSM quadtree;
 //! writes `indirect` (barriers below).
 
@@ -115,8 +115,8 @@ impl RsmSplat {
             &full_resolution_bindings(setup),
             GraphicsDesc {
                 name: "rsm-splat",
-                vertex_shader: "vpl_splat.vert",
-                fragment_shader: "vpl_splat.frag",
+                vertex_shader: "rsm_splat/splat.vert",
+                fragment_shader: "rsm_splat/splat.frag",
                 color_formats: &[format],
                 blend: Blend::Additive,
                 specialization: &[

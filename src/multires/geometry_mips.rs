@@ -1,8 +1,8 @@
 //! Pass `geometry-mips`: levels 1..=L of the geometry mipmaps (docs/algorithm.md
 //! section 3, steps 2-4), one full-screen draw per level into that level's mip
 //! of the five chains (level 0 is the G-buffer itself):
-//! `shaders/geometry_level_one.frag` reads the G-buffer,
-//! `shaders/geometry_mips.frag` level l - 1 (`shaders/geometry_mips.glsl`).
+//! `shaders/multires/geometry_level_one.frag` reads the G-buffer,
+//! `shaders/multires/geometry_mips.frag` level l - 1 (`shaders/multires/geometry_mips.glsl`).
 //! Reads the G-buffer; writes `geo_*` (barriers below).
 
 use super::MultiresBuffer;
@@ -46,7 +46,7 @@ impl GeometryMipsPass {
                 Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
                 Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
             ],
-            desc("geometry_level_one.frag"),
+            desc("multires/geometry_level_one.frag"),
         )?;
         // Level l (2..=L) reads mip l - 2, level l - 1 (mip m is level m + 1).
         let above_sets = (2..=m.levels as usize)
@@ -67,7 +67,7 @@ impl GeometryMipsPass {
                     gpu,
                     &GraphicsDesc {
                         sets,
-                        ..desc("geometry_mips.frag")
+                        ..desc("multires/geometry_mips.frag")
                     },
                 )?;
                 Some((pipeline, above_sets))

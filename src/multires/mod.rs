@@ -161,7 +161,7 @@ pub fn write_uniforms(s: &RenderSettings, u: &mut RunUniforms) {
 
 /// The images of the hierarchy. Geometry mips are mip chains holding levels
 /// 1..=L (mip m is level m + 1, (W >> (m + 1)) x (H >> (m + 1))); level 0 is
-/// the G-buffer itself (`shaders/geo_levels.glsl`). The illumination buffer and
+/// the G-buffer itself (`shaders/multires/geo_levels.glsl`). The illumination buffer and
 /// its stencil are 2D arrays with one W x H layer per level, layer l using
 /// its corner.
 pub struct MultiresBuffer {
@@ -174,9 +174,9 @@ pub struct MultiresBuffer {
     pub geo_flags: Image,
     /// What the upsampling's push into level l - 1 reads of each level-l texel
     /// (l >= 1): its value and its relation to its neighbours, in layer l % 2
-    /// (`upsample.comp`, `store_tap`). Two layers of level 1's size.
+    /// (`multires/upsample.comp`, `store_tap`). Two layers of level 1's size.
     pub upsample_taps: Image,
-    /// Irradiance E per patch (rgb) and the texel state in alpha (see `upsample.glsl`).
+    /// Irradiance E per patch (rgb) and the texel state in alpha (see `multires/upsample.glsl`).
     pub illumination: Image,
     /// Light patches each eye-space patch evaluated (a count in R32_SFLOAT, so
     /// splats can add it up; layered like the illumination buffer).
@@ -199,7 +199,7 @@ impl MultiresBuffer {
                     | vk::FormatFeatureFlags::TRANSFER_SRC,
             )
             .ok_or_else(|| anyhow!("the device has no stencil format usable as an attachment"))?;
-        // geometry_mips.frag reads five storage images and writes five color
+        // multires/geometry_mips.frag reads five storage images and writes five color
         // attachments (Vulkan guarantees four of each per fragment stage).
         let limits = gpu.limits();
         let (storage_images, colors, outputs) = (
@@ -247,7 +247,7 @@ impl MultiresBuffer {
             )
         };
         // Every geometry-mip chain starts at level 1 (level 0 is the G-buffer,
-        // `shaders/geo_levels.glsl`): mip m of these chains is level m + 1.
+        // `shaders/multires/geo_levels.glsl`): mip m of these chains is level m + 1.
         let chain = |name, format| {
             Image::new(
                 gpu,
@@ -260,7 +260,7 @@ impl MultiresBuffer {
                     },
                     layers: 1,
                     mips: levels,
-                    // Written as attachments (geometry_mips.glsl).
+                    // Written as attachments (multires/geometry_mips.glsl).
                     usage: storage | vk::ImageUsageFlags::COLOR_ATTACHMENT,
                 },
             )

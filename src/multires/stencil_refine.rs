@@ -1,6 +1,6 @@
 //! Pass `stencil-refine`: the one-pass stenciled refinement (docs/algorithm.md
 //! section 3, step 4). One instanced draw covers every layer of the stencil
-//! (`shaders/layered.vert` picks the layer); `shaders/stencil_refine.frag`
+//! (`shaders/multires/layered.vert` picks the layer); `shaders/multires/stencil_refine.frag`
 //! discards texels that are not patches and the stencil op writes 1 for the
 //! rest. Reads `geo_flags`; writes the layered stencil and, in a frame that
 //! counts (`Profiler::counting`), the patch counts.
@@ -15,7 +15,7 @@ use anyhow::Result;
 use ash::vk;
 
 /// The same draw with and without the per-level patch counts (specialisation
-/// constant 0 of `stencil_refine.frag`): their atomics are statistics, paid
+/// constant 0 of `multires/stencil_refine.frag`): their atomics are statistics, paid
 /// only in the frame that counts, like the profiler's queries.
 pub struct StencilRefinePass {
     counting: PassPipeline,
@@ -46,8 +46,8 @@ impl StencilRefinePass {
                 &bindings,
                 GraphicsDesc {
                     name: "stencil-refine",
-                    vertex_shader: "layered.vert",
-                    fragment_shader: "stencil_refine.frag",
+                    vertex_shader: "multires/layered.vert",
+                    fragment_shader: "multires/stencil_refine.frag",
                     stencil_format: m.stencil.format,
                     stencil: Some(StencilTest::WRITE_ONE),
                     specialization: &[crate::vk::pipeline::Spec::bool("COUNT", count)],

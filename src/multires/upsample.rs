@@ -1,10 +1,10 @@
 //! Pass `upsample`: the illumination buffer to a full-resolution indirect image
 //! (docs/algorithm.md section 3, step 7): a pull from level 1 up to L and a push
-//! from L - 1 down to 1 (`shaders/upsample.comp`), then the push into level 0
-//! as a full-screen draw into `indirect` (`shaders/upsample_level0.frag`),
+//! from L - 1 down to 1 (`shaders/multires/upsample.comp`), then the push into level 0
+//! as a full-screen draw into `indirect` (`shaders/multires/upsample_level0.frag`),
 //! nearest or interpolated by a specialisation constant. The dispatch that
 //! finalises a level l >= 1 (the pull of L, every push) writes the taps the
-//! push into l - 1 reads (`upsample_taps`, `shaders/upsample.glsl`).
+//! push into l - 1 reads (`upsample_taps`, `shaders/multires/upsample.glsl`).
 //! Reads the illumination buffer and geometry mips; writes `indirect`.
 
 use super::{MultiresBuffer, Upsample};
@@ -15,7 +15,7 @@ use crate::vk::pipeline::{Binding, GraphicsDesc, PassPipeline, Spec};
 use crate::vk::profiler::Profiler;
 use anyhow::Result;
 
-/// One pipeline per kind of dispatch (`upsample.comp`'s specialisation
+/// One pipeline per kind of dispatch (`multires/upsample.comp`'s specialisation
 /// constants): CPU drivers execute every branch of a shader under a lane mask,
 /// so one shader for all kinds would run all their code per invocation.
 pub struct UpsamplePass {
@@ -46,7 +46,7 @@ impl UpsamplePass {
             ComputePass::new(
                 setup,
                 "upsample",
-                "upsample.comp",
+                "multires/upsample.comp",
                 std::slice::from_ref(&bindings),
                 4,
                 &[
@@ -65,7 +65,7 @@ impl UpsamplePass {
             ],
             GraphicsDesc {
                 name: "upsample",
-                fragment_shader: "upsample_level0.frag",
+                fragment_shader: "multires/upsample_level0.frag",
                 color_formats: &[t.indirect.format],
                 specialization: &[interpolate],
                 ..Default::default()

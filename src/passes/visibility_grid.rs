@@ -4,16 +4,16 @@
 //! which builds the voxel occupancy grid of this frame's posed scene.
 //!
 //! The grid is one storage buffer, set 0 binding 3 of every pipeline (the
-//! frame set, `frame::FrameSet`): `shaders/visibility_grid.comp` and
-//! `shaders/visibility_grid_levels.comp` write it,
+//! frame set, `frame::FrameSet`): `shaders/voxel_grid/voxelize.comp` and
+//! `shaders/voxel_grid/levels.comp` write it,
 //! the patch formula (`patch_irradiance`, `shaders/vpl.glsl`) of every
-//! gathering method reads it through `shaders/visibility.glsl`. Nothing is
+//! gathering method reads it through `shaders/voxel_grid/march.glsl`. Nothing is
 //! kept across frames: the pass clears it, voxelizes every instance's
 //! triangles, posed by this frame's transforms, into the finest level of the
 //! cube [`grid_cube`] puts around them (the large triangles by whole
 //! workgroups, the rest one per invocation: [`TriangleOrder`]), then makes
 //! each coarser level the OR of the one below it
-//! (`shaders/visibility_grid_levels.comp`).
+//! (`shaders/voxel_grid/levels.comp`).
 //!
 //! Barriers (in `record`): the previous frame's readers (shaders of every
 //! stage, the readback copy) before the clear; the clear before the
@@ -145,7 +145,7 @@ pub fn unused_grid_warning(s: &RenderSettings, grid_used: bool) -> Option<String
 /// formula, marches the grid or builds it: `VOXEL_VISIBILITY`
 /// (`shaders/vpl.glsl`; the march is compiled only into runs with the grid,
 /// as a uniform branch around it slowed every gather on lavapipe) and
-/// `GRID_SUB` (`shaders/visibility_layout.glsl`; the layout and the march's
+/// `GRID_SUB` (`shaders/voxel_grid/layout.glsl`; the layout and the march's
 /// sub-cell samples). Shaders without a constant ignore its entry.
 pub fn specialization(s: &RenderSettings) -> [Spec; 2] {
     [
@@ -163,7 +163,7 @@ pub fn memory(s: &RenderSettings) -> u64 {
 }
 
 /// Bytes of a grid of side `n` with `sub` sub-cells per side of a finest
-/// cell (`shaders/visibility_layout.glsl`): a bit per cell of every OR-level,
+/// cell (`shaders/voxel_grid/layout.glsl`): a bit per cell of every OR-level,
 /// about n^3 / 56 bytes, and a bit (`sub` 1) or a 64-bit mask of its
 /// sub-cells (2, 4) per finest cell.
 pub fn grid_bytes(n: u32, sub: u32) -> u64 {
@@ -265,7 +265,7 @@ pub fn grid_buffer(gpu: &Gpu, s: &RenderSettings) -> Result<Buffer> {
 
 /// Lavapipe ends all loops of a shader invocation after 65,535 iterations
 /// together (gallivm's loop limiter), silently. A march through the grid
-/// takes at most `VISIBILITY_MAX_ITERATIONS` (13, `shaders/visibility.glsl`)
+/// takes at most `VISIBILITY_MAX_ITERATIONS` (13, `shaders/voxel_grid/march.glsl`)
 /// iterations, its evaluation one more of the caller's loop and one to test
 /// the march's condition: this many per evaluation.
 pub const LOOP_ITERATIONS_PER_EVALUATION: u64 = 15;
@@ -274,7 +274,7 @@ pub const LOOP_ITERATIONS_PER_EVALUATION: u64 = 15;
 pub const LOOP_BUDGET: u64 = 61_440;
 
 /// Workgroup size of the voxelization (`local_size_x` of
-/// `shaders/visibility_grid.comp`).
+/// `shaders/voxel_grid/voxelize.comp`).
 const WORKGROUP: u32 = 64;
 
 /// Triangles per dispatch: 64 per workgroup, at most 65,535 workgroups.
@@ -297,10 +297,10 @@ pub fn rows_per_triangle(columns: u32) -> u32 {
 /// Pass `visibility-grid`.
 pub struct VisibilityGridPass {
     /// The voxelization of the large triangles and of the others
-    /// (`visibility_grid.comp` with `LARGE` true and false).
+    /// (`voxel_grid/voxelize.comp` with `LARGE` true and false).
     large: Pipeline,
     small: Pipeline,
-    /// The OR-levels (`visibility_grid_levels.comp`).
+    /// The OR-levels (`voxel_grid/levels.comp`).
     levels: Pipeline,
     set: DescriptorSet,
     order: TriangleOrder,
@@ -352,7 +352,7 @@ impl VisibilityGridPass {
                 } else {
                     "visibility-grid"
                 },
-                "visibility_grid.comp",
+                "voxel_grid/voxelize.comp",
                 &[setup.frame, &set],
                 std::mem::size_of::<VisibilityGridPush>() as u32,
                 &constants,
@@ -362,7 +362,7 @@ impl VisibilityGridPass {
         let levels = Pipeline::compute(
             setup.gpu,
             "visibility-grid levels",
-            "visibility_grid_levels.comp",
+            "voxel_grid/levels.comp",
             &[setup.frame],
             std::mem::size_of::<VisibilityGridLevelPush>() as u32,
             &specialization(setup.settings)[1..],

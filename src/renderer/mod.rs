@@ -286,7 +286,7 @@ impl<'g> Renderer<'g> {
         )
     }
 
-    /// The voxel visibility grid's buffer (its bits, `shaders/visibility.glsl`).
+    /// The voxel visibility grid's buffer (its bits, `shaders/voxel_grid/march.glsl`).
     pub fn visibility_grid(&self) -> Option<&Buffer> {
         self.grid_in_use.then_some(&self.visibility_grid)
     }

@@ -51,7 +51,7 @@ impl Renderer<'_> {
         self.patches(self.method.chosen_patches())
     }
 
-    /// HISR's packed light tree, root first (`shaders/light_tree_pack.comp`),
+    /// HISR's packed light tree, root first (`shaders/hisr/tree_pack.comp`),
     /// positions in world space.
     pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
         self.patches(self.method.packed_light_tree())

@@ -1,6 +1,6 @@
 //! What the viewer adds to the renderer's frame: the `present` pass (the
-//! frame's image scaled into the swapchain image, `present.frag`), the
-//! `overlay` pass (text, `overlay_text.vert/.frag`), an optional copy of the
+//! frame's image scaled into the swapchain image, `viewer/present.frag`), the
+//! `overlay` pass (text, `viewer/overlay_text.vert/.frag`), an optional copy of the
 //! result for a screenshot, and the barriers that hand the swapchain image
 //! from acquisition to presentation. Both passes are timed by the frame's
 //! profiler like the renderer's own.
@@ -134,7 +134,7 @@ impl Presenter {
             &GraphicsDesc {
                 name: "present",
                 vertex_shader: "fullscreen.vert",
-                fragment_shader: "present.frag",
+                fragment_shader: "viewer/present.frag",
                 sets: &[frame_set, &present_set],
                 push_constant_bytes: std::mem::size_of::<PresentPush>() as u32,
                 color_formats: &[format],
@@ -166,8 +166,8 @@ impl Presenter {
             gpu,
             &GraphicsDesc {
                 name: "overlay",
-                vertex_shader: "overlay_text.vert",
-                fragment_shader: "overlay_text.frag",
+                vertex_shader: "viewer/overlay_text.vert",
+                fragment_shader: "viewer/overlay_text.frag",
                 // Set 0 is the frame set in every pipeline, used or not.
                 sets: &[frame_set, &overlay_set],
                 push_constant_bytes: std::mem::size_of::<OverlayPush>() as u32,

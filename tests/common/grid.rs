@@ -9,7 +9,7 @@ use isr::settings::RenderSettings;
 use isr::vk::Gpu;
 
 /// The voxel grid after one frame of `scene` with `settings` (which use it):
-/// its words as read back (`shaders/visibility_layout.glsl`), its cube
+/// its words as read back (`shaders/voxel_grid/layout.glsl`), its cube
 /// (`Renderer::visibility_cube`, relative to the render origin) and the
 /// render origin. Fails the test if validation spoke.
 pub fn rendered_grid(

@@ -1,4 +1,4 @@
-//! The host's copy of what `shaders/lpv.glsl` and `shaders/lpv_lookup.frag`
+//! The host's copy of what `shaders/lpv/lpv.glsl` and `shaders/lpv/lookup.frag`
 //! compute (docs/algorithm.md section 8): where the cascades are, the 2-band
 //! SH, and the irradiance a point reads from a cascade. Tests read the GPU's
 //! grids back into a [`Grid`] and compare.
@@ -7,7 +7,7 @@ use super::Layout;
 use crate::gpu_types::FrameUniforms;
 use glam::{DVec3, IVec3, Vec3};
 
-/// SH basis constants (`shaders/lpv.glsl`): `Y0`, `Y1`, the clamped
+/// SH basis constants (`shaders/lpv/lpv.glsl`): `Y0`, `Y1`, the clamped
 /// cosine's projection and the integral of an SH function per unit `c0`.
 pub const SH_Y0: f64 = 0.282_094_791_773_878_14;
 pub const SH_Y1: f64 = 0.488_602_511_902_919_9;
@@ -115,7 +115,7 @@ impl Grid {
 
     /// The irradiance (W/m^2, per channel) a point `p` with unit normal `n`
     /// reads from cascade `c` placed at `at`, as `cascade_irradiance` in
-    /// `shaders/lpv_lookup.frag` does (half a cell along `n`, trilinear
+    /// `shaders/lpv/lookup.frag` does (half a cell along `n`, trilinear
     /// between cell centres, clamped to the grid).
     pub fn irradiance(&self, c: u32, at: &Cascade, p: DVec3, n: DVec3) -> DVec3 {
         let size = self.layout.size as f64;
@@ -141,7 +141,7 @@ impl Grid {
     }
 
     /// How much of a point's irradiance cascade `c` at `at` gives (before the
-    /// finer cascades take their share), as `lpv_lookup.frag` weighs it: 1
+    /// finer cascades take their share), as `lpv/lookup.frag` weighs it: 1
     /// inside, falling to 0 over the outer `blend_cells()` cell centres; the
     /// coarsest takes all of what is left within half a cell of its last
     /// centres.
@@ -156,7 +156,7 @@ impl Grid {
         }
     }
 
-    /// The irradiance `lpv_lookup.frag` writes for a point `p` with unit
+    /// The irradiance `lpv/lookup.frag` writes for a point `p` with unit
     /// normal `n`: the finest cascade that holds it, blended into the next
     /// coarser one near its border.
     pub fn lookup(&self, cascades: &[Cascade], p: DVec3, n: DVec3) -> DVec3 {

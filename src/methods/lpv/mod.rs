@@ -92,7 +92,7 @@ impl Layout {
     }
 
     /// Cells over which the lookup hands a cascade over to the next coarser
-    /// one near its border (`BLEND` in `shaders/lpv_lookup.frag`): an eighth
+    /// one near its border (`BLEND` in `shaders/lpv/lookup.frag`): an eighth
     /// of the side, at least 1.
     pub fn blend_cells(&self) -> u32 {
         (self.size / 8).max(1)

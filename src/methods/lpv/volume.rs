@@ -2,16 +2,16 @@
 //! images, buffers and pipelines, and the passes each light view records.
 //!
 //! - `lpv-geometry` (once per frame, camera only; with `--lpv-occlusion`):
-//!   `lpv_geometry.vert/.frag` splat the G-buffer's surfels' blocking
+//!   `lpv/geometry.vert/.frag` splat the G-buffer's surfels' blocking
 //!   potentials into the eye geometry volume.
-//! - `lpv-inject` (per view): `lpv_inject.vert/.frag` splat the RSM's VPLs
+//! - `lpv-inject` (per view): `lpv/inject.vert/.frag` splat the RSM's VPLs
 //!   into the three injection images (one per colour channel) and, with
 //!   occlusion, `lpv_geometry.*` the RSM's surfels into the light geometry
 //!   volume; then the injection images are copied into the first iteration
 //!   buffer and the sum.
-//! - `lpv-propagate` (per view): `lpv_propagate.comp`, one dispatch per
+//! - `lpv-propagate` (per view): `lpv/propagate.comp`, one dispatch per
 //!   iteration, ping-ponging between two buffers and adding into the sum.
-//! - `lpv-lookup` (per view): `fullscreen.vert` + `lpv_lookup.frag` write
+//! - `lpv-lookup` (per view): `fullscreen.vert` + `lpv/lookup.frag` write
 //!   `indirect` from the sum.
 //!
 //! Splats are single-texel triangles rasterized into layered 2D-array colour
@@ -145,8 +145,8 @@ impl Lpv {
             ],
             GraphicsDesc {
                 name: "lpv-inject",
-                vertex_shader: "lpv_inject.vert",
-                fragment_shader: "lpv_inject.frag",
+                vertex_shader: "lpv/inject.vert",
+                fragment_shader: "lpv/inject.frag",
                 color_formats: &[SH_FORMAT; 3],
                 blend: Blend::Additive,
                 specialization: &[
@@ -169,8 +169,8 @@ impl Lpv {
                 ],
                 GraphicsDesc {
                     name: "lpv-geometry",
-                    vertex_shader: "lpv_geometry.vert",
-                    fragment_shader: "lpv_geometry.frag",
+                    vertex_shader: "lpv/geometry.vert",
+                    fragment_shader: "lpv/geometry.frag",
                     color_formats: &[GEOMETRY_FORMAT],
                     blend: Blend::Additive,
                     specialization: &[
@@ -199,7 +199,7 @@ impl Lpv {
         let propagate = ComputePass::new(
             setup,
             "lpv-propagate",
-            "lpv_propagate.comp",
+            "lpv/propagate.comp",
             &[variant(0), variant(1)],
             0,
             &[spec[0], spec[1], Spec::bool("OCCLUSION", layout.occlusion)],
@@ -215,7 +215,7 @@ impl Lpv {
             GraphicsDesc {
                 name: "lpv-lookup",
                 vertex_shader: "fullscreen.vert",
-                fragment_shader: "lpv_lookup.frag",
+                fragment_shader: "lpv/lookup.frag",
                 color_formats: &[t.indirect.format],
                 specialization: &spec,
                 ..Default::default()

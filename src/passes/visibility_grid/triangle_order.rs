@@ -1,6 +1,6 @@
 //! Each mesh's triangles ordered largest first, for pass `visibility-grid`
 //! to hand its large triangles to whole workgroups and the rest to one
-//! invocation each (`shaders/visibility_grid.comp`; docs/algorithm.md
+//! invocation each (`shaders/voxel_grid/voxelize.comp`; docs/algorithm.md
 //! section 5, "Voxel visibility").
 
 use crate::scene::Scene;
@@ -15,7 +15,7 @@ const LARGE_SUBCELLS: f32 = 64.0;
 /// Every mesh's triangles, largest first, for the voxelization to tell the
 /// large from the small each frame with one search per instance: the
 /// position of each one's first index (in the scene's index buffer, bound at
-/// set 1 binding 2 of `visibility_grid.comp`, at the triangle's own place),
+/// set 1 binding 2 of `voxel_grid/voxelize.comp`, at the triangle's own place),
 /// and per mesh each one's size, its bounding box's diagonal in the mesh's
 /// own space, falling.
 pub struct TriangleOrder {
