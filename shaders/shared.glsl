@@ -31,7 +31,7 @@ struct FrameUniforms {
     int pad3;
     mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
-    vec4 visibility_grid;   // the voxel visibility grid's cube around this frame's posed scene:
+    vec4 grid_cube;         // the voxel grid's cube around this frame's posed scene:
                             // xyz its min corner (m), w the side of a finest cell (m)
 };
 
@@ -81,17 +81,12 @@ struct RunUniforms {
     // hisr_reach in hisr/hisr.glsl).
     float hisr_tau;               // --tau
     int hisr_tau_mode;            // HISR_TAU_*
-    // Indirect visibility (docs/algorithm.md section 5, "Voxel visibility";
-    // passes::visibility_grid).
-    int visibility;               // VISIBILITY_*: the term the patch formula applies
-    int visibility_side;          // N: finest cells per side of the grid (a power of 2)
-    int visibility_levels;        // levels 0..visibility_levels-1, side N >> k (at least 4)
     int patch_kernel;             // PATCH_KERNEL_*: how a merged light patch is evaluated (vpl.glsl)
+    // The voxel grid (docs/algorithm.md section 5.6; src/voxel_grid).
+    int grid_side;                // N: finest cells per side (a power of 2)
+    int grid_levels;              // levels 0..grid_levels-1, side N >> k (at least 4)
+    int pad0;
 };
-
-// RunUniforms::visibility: which visibility term patch_irradiance applies (vpl.glsl).
-const int VISIBILITY_NONE = 0;    // none: every patch lights every receiver it faces
-const int VISIBILITY_VOXELS = 1;  // the segment marched through the occupancy grid (voxel_grid/march.glsl)
 
 // RunUniforms::patch_kernel (docs/algorithm.md section 2.6): a patch of
 // several RSM texels evaluated at its centre with the disc form factor, or
@@ -197,7 +192,7 @@ struct MaterialGpu {
 
 // Push constants of one dispatch of pass visibility-grid (voxel_grid/voxelize.comp):
 // a range of one instance's triangles, one invocation each.
-struct VisibilityGridPush {
+struct VoxelizePush {
     uint first_index;     // the instance's mesh's first index
     int vertex_offset;    // added to its indices
     uint instance;        // index into the frame's InstanceTransform array
@@ -207,7 +202,7 @@ struct VisibilityGridPush {
 
 // Push constants of one dispatch of pass visibility-grid's OR-levels
 // (voxel_grid/levels.comp).
-struct VisibilityGridLevelPush {
+struct GridLevelPush {
     int level;  // the level it reads; it writes level + 1
 };
 

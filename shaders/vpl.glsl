@@ -3,7 +3,7 @@
 #define VPL_GLSL
 #include "voxel_grid/march.glsl"
 
-// Whether the march is compiled in at all (src/passes/visibility_grid.rs
+// Whether the march is compiled in at all (src/passes/voxel_grid/voxelize.rs
 // sets it from --visibility): a uniform branch around it cost lavapipe
 // 1.3-2.7x on every gather and splat without the grid.
 layout(constant_id = 20) const bool VOXEL_VISIBILITY = false;

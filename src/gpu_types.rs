@@ -39,10 +39,9 @@ pub struct FrameUniforms {
     pub pad3: i32,
     /// Point lights: world -> clip of each cube face, for the layered draw.
     pub cube_view_proj: [[[f32; 4]; 4]; 6],
-    /// The voxel visibility grid's cube around this frame's posed scene: xyz
-    /// its min corner, w a finest cell's side (m;
-    /// `passes::visibility_grid::grid_cube`).
-    pub visibility_grid: [f32; 4],
+    /// The voxel grid's cube around this frame's posed scene: xyz its min
+    /// corner, w a finest cell's side (m; `voxel_grid::grid_cube`).
+    pub grid_cube: [f32; 4],
 }
 
 /// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.
@@ -86,29 +85,25 @@ pub struct RunUniforms {
     /// HISR's tau and `HISR_TAU_*` (`methods::hisr`).
     pub hisr_tau: f32,
     pub hisr_tau_mode: i32,
-    /// Indirect visibility (`passes::visibility_grid::write_uniforms`):
-    /// `VISIBILITY_*`, the grid's finest side N and its level count.
-    pub visibility: i32,
-    pub visibility_side: i32,
-    pub visibility_levels: i32,
     /// How a merged light patch is evaluated (`passes::rsm_tree::PATCH_KERNEL`):
     /// `PATCH_KERNEL_*`.
     pub patch_kernel: i32,
+    /// The voxel grid's finest side N and its level count
+    /// (`voxel_grid::write_uniforms`).
+    pub grid_side: i32,
+    pub grid_levels: i32,
+    pub pad0: i32,
 }
-
-/// `RunUniforms::visibility` values, as in `shaders/shared.glsl`.
-pub const VISIBILITY_NONE: i32 = 0;
-pub const VISIBILITY_VOXELS: i32 = 1;
 
 /// `RunUniforms::patch_kernel` values, as in `shaders/shared.glsl`.
 pub const PATCH_KERNEL_CENTRE: i32 = 0;
 pub const PATCH_KERNEL_SECOND_ORDER: i32 = 1;
 
-/// `VisibilityGridPush`: one dispatch of pass `visibility-grid`, a range of
-/// one instance's triangles.
+/// `VoxelizePush`: one dispatch of pass `voxel-grid`, a range of one
+/// instance's triangles.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct VisibilityGridPush {
+pub struct VoxelizePush {
     pub first_index: u32,
     pub vertex_offset: i32,
     pub instance: u32,
@@ -116,11 +111,11 @@ pub struct VisibilityGridPush {
     pub triangles: u32,
 }
 
-/// `VisibilityGridLevelPush`: one dispatch of pass `visibility-grid`'s
-/// OR-levels, which reads level `level` and writes `level + 1`.
+/// `GridLevelPush`: one dispatch of pass `voxel-grid`'s OR-levels, which
+/// reads level `level` and writes `level + 1`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct VisibilityGridLevelPush {
+pub struct GridLevelPush {
     pub level: i32,
 }
 

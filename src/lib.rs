@@ -10,6 +10,7 @@
 pub mod bench;
 pub mod cli;
 pub mod debug_view;
+pub mod exact_visibility;
 pub mod frame;
 pub mod gpu_types;
 pub mod methods;
@@ -28,3 +29,4 @@ pub mod view;
 pub mod viewer;
 pub mod visibility;
 pub mod vk;
+pub mod voxel_grid;

@@ -2,8 +2,8 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, HisrCutHeader, InstanceTransform, LightPatch, MaterialGpu,
-    RunUniforms, VisibilityGridLevelPush, VisibilityGridPush,
+    DrawPush, FrameUniforms, GridLevelPush, HisrCutHeader, InstanceTransform, LightPatch,
+    MaterialGpu, RunUniforms, VoxelizePush,
 };
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
@@ -94,7 +94,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", visibility_grid: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", grid_cube: 16, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -116,7 +116,7 @@ fn frame_uniforms_match_shared_glsl() {
             pad2 => "pad2",
             pad3 => "pad3",
             cube_view_proj => "cube_view_proj",
-            visibility_grid => "visibility_grid",
+            grid_cube => "grid_cube",
         ]);
     }
 }
@@ -128,7 +128,7 @@ fn run_uniforms_match_shared_glsl() {
         "multires/gather.frag",
         "multires/upsample.comp",
     ] {
-        check!(shader, RunUniforms, "RunUniforms", patch_kernel: 4, [
+        check!(shader, RunUniforms, "RunUniforms", pad0: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
             pcf_radius => "pcf_radius",
@@ -152,10 +152,10 @@ fn run_uniforms_match_shared_glsl() {
             splat_threshold => "splat_threshold",
             hisr_tau => "hisr_tau",
             hisr_tau_mode => "hisr_tau_mode",
-            visibility => "visibility",
-            visibility_side => "visibility_side",
-            visibility_levels => "visibility_levels",
             patch_kernel => "patch_kernel",
+            grid_side => "grid_side",
+            grid_levels => "grid_levels",
+            pad0 => "pad0",
         ]);
     }
 }
@@ -214,8 +214,8 @@ fn draw_push_matches_shared_glsl() {
 }
 
 #[test]
-fn visibility_grid_push_matches_shared_glsl() {
-    check!("voxel_grid/voxelize.comp", VisibilityGridPush, "VisibilityGridPush", triangles: 4, [
+fn voxelize_push_matches_shared_glsl() {
+    check!("voxel_grid/voxelize.comp", VoxelizePush, "VoxelizePush", triangles: 4, [
         first_index => "first_index",
         vertex_offset => "vertex_offset",
         instance => "instance",
@@ -225,8 +225,8 @@ fn visibility_grid_push_matches_shared_glsl() {
 }
 
 #[test]
-fn visibility_grid_level_push_matches_shared_glsl() {
-    check!("voxel_grid/levels.comp", VisibilityGridLevelPush, "VisibilityGridLevelPush", level: 4, [
+fn grid_level_push_matches_shared_glsl() {
+    check!("voxel_grid/levels.comp", GridLevelPush, "GridLevelPush", level: 4, [
         level => "level",
     ]);
 }
@@ -286,8 +286,6 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("HISR_TAU_RELATIVE"), HISR_TAU_RELATIVE as u32);
     assert_eq!(value("HISR_TAU_ABSOLUTE"), HISR_TAU_ABSOLUTE as u32);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
-    assert_eq!(value("VISIBILITY_NONE"), VISIBILITY_NONE as u32);
-    assert_eq!(value("VISIBILITY_VOXELS"), VISIBILITY_VOXELS as u32);
     assert_eq!(value("PATCH_KERNEL_CENTRE"), PATCH_KERNEL_CENTRE as u32);
     assert_eq!(
         value("PATCH_KERNEL_SECOND_ORDER"),
@@ -371,7 +369,7 @@ mod bindings {
             // Read by the patch formula (voxel_grid/march.glsl), written by
             // voxel_grid/voxelize.comp.
             BindingInfo {
-                name: "VisibilityGrid",
+                name: "GridOccupancy",
                 kind: Kind::StorageBuffer,
             },
         ]

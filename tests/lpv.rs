@@ -61,8 +61,8 @@ impl<'g> Probe<'g> {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )
         .unwrap();
-        let grid = isr::passes::visibility_grid::grid_buffer(gpu, settings).unwrap();
-        let frame = FrameSet::new(gpu, &run, &grid, scene.instances.len()).unwrap();
+        let grid = isr::voxel_grid::VoxelGrid::new(gpu, settings, false).unwrap();
+        let frame = FrameSet::new(gpu, &run, &grid.occupancy, scene.instances.len()).unwrap();
         let samplers = Samplers::new(gpu).unwrap();
         let lpv = Lpv::new(&Setup {
             gpu,
@@ -79,7 +79,7 @@ impl<'g> Probe<'g> {
             profiler: Profiler::new(gpu, 16).unwrap(),
             _samplers: samplers,
             frame,
-            _grid: grid,
+            _grid: grid.occupancy,
             _run: run,
             renderer,
         }

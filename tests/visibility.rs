@@ -9,11 +9,11 @@ mod common;
 use common::*;
 use glam::Vec3;
 use isr::bench::truth::{trace, ShadowMaps};
+use isr::exact_visibility::{gather, patch_irradiance, Vpl};
 use isr::pathtrace::Occluders;
 use isr::readback::{Readback, RsmReadback};
 use isr::scene::cornell::cornell_box;
 use isr::scene::{Camera, Scene};
-use isr::visibility::{gather, patch_irradiance, Vpl};
 
 /// Receivers on the floor y = 0, facing up: an n x n grid over [-s, s]^2.
 fn floor_receivers(n: u32, s: f32) -> Readback {
@@ -166,7 +166,7 @@ fn the_cpu_gather_is_the_gpu_reference_and_finds_no_shadow_in_an_empty_room() {
         .collect();
     empty.instances.retain(|i| keep[i.mesh]);
     let r = reference_frame(&empty, 48, 32);
-    let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
+    let vpls = isr::exact_visibility::texel_vpls(&r.readback.rsm);
     let cpu = gather(&r.readback, &vpls, None, |_, _| {});
     let mask = geometry_mask(&r.readback.position);
     let e = relative_rmse(&cpu, &r.readback.indirect, &mask);
@@ -189,7 +189,7 @@ fn exact_visibility_brings_the_dense_reference_to_the_truth_in_the_box_with_bloc
     scene.animation = None;
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu(), &scene, &settings, 1);
-    let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
+    let vpls = isr::exact_visibility::texel_vpls(&r.readback.rsm);
     let o = Occluders::new(&scene);
     let exact = gather(&r.readback, &vpls, Some(&o), |_, _| {});
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);

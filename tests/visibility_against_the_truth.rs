@@ -8,9 +8,9 @@ mod common;
 
 use common::*;
 use isr::bench::truth::{trace, ShadowMaps};
+use isr::exact_visibility::gather;
 use isr::pathtrace::Occluders;
 use isr::scene::Scene;
-use isr::visibility::gather;
 
 /// Measurement (`cargo test --release --test visibility_against_the_truth -- --ignored
 /// --nocapture`): every bench scene at rest, 64x64, RSM 64, against the
@@ -37,7 +37,7 @@ fn voxel_visibility_on_the_bench_scenes_against_the_truth() {
         let model = |x: &[[f32; 4]]| model_error(x, &t);
         let vox = render(&gpu, &scene, &voxels(settings.clone(), 64), 1).readback;
         let fine = render(&gpu, &scene, &plain_grid(voxels(settings.clone(), 256)), 1).readback;
-        let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
+        let vpls = isr::exact_visibility::texel_vpls(&r.readback.rsm);
         let exact = gather(&r.readback, &vpls, Some(&Occluders::new(&scene)), |_, _| {});
         let hisr = sized("hisr", 64, 64, 64);
         let h = render(&gpu, &scene, &hisr, 1).readback;
@@ -157,7 +157,7 @@ fn grid_sizes_on_the_bench_scenes_against_the_truth() {
             let mut e = vec![model(&render(&gpu, &scene, &s, 1).readback.indirect)];
             for (n, sub) in grids {
                 let mut v = voxels(s.clone(), n);
-                isr::passes::visibility_grid::SUBCELLS.set(&mut v, sub);
+                isr::voxel_grid::SUBCELLS.set(&mut v, sub);
                 e.push(model(&render(&gpu, &scene, &v, 1).readback.indirect));
             }
             let cells: Vec<String> = e

@@ -8,11 +8,11 @@ mod common;
 use common::*;
 use glam::Vec3;
 use isr::bench::truth::{trace, ShadowMaps};
-use isr::passes::visibility_grid::{GRID, SUBCELLS};
+use isr::exact_visibility::gather;
 use isr::pathtrace::Occluders;
 use isr::scene::{Camera, Scene};
 use isr::settings::RenderSettings;
-use isr::visibility::gather;
+use isr::voxel_grid::{GRID, SUBCELLS};
 
 /// The gathering methods, each small.
 const GATHERS: [&str; 8] = [
@@ -165,7 +165,7 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
     let scene = cornell_at_rest(true);
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu, &scene, &settings, 1);
-    let vpls = isr::visibility::texel_vpls(&r.readback.rsm);
+    let vpls = isr::exact_visibility::texel_vpls(&r.readback.rsm);
     let o = Occluders::new(&scene);
     let exact = gather(&r.readback, &vpls, Some(&o), |_, _| {});
     let mask = geometry_mask(&r.readback.position);
@@ -306,7 +306,7 @@ fn the_grid_marks_the_boxs_walls_and_leaves_its_inside_empty() {
         "sub-cells: {wrong} wrong of {walls}"
     );
     // The OR-levels: one bit per cell, each the OR of the 8 cells under it.
-    let levels = isr::passes::visibility_grid::levels(n);
+    let levels = isr::voxel_grid::levels(n);
     let mut offset = 2 * m * m * m;
     for k in 1..levels {
         let m = (n >> k) as usize;
@@ -336,10 +336,7 @@ fn the_grid_marks_the_boxs_walls_and_leaves_its_inside_empty() {
         offset += m * m * m / 32;
         previous = occupied;
     }
-    assert_eq!(
-        offset * 4,
-        isr::passes::visibility_grid::grid_bytes(n, 4) as usize
-    );
+    assert_eq!(offset * 4, isr::voxel_grid::grid_bytes(n, 4) as usize);
 }
 
 #[test]
@@ -352,13 +349,10 @@ fn a_method_switch_uses_the_grid_made_with_the_run_and_refuses_one_never_made() 
     let hisr = voxels(sized("hisr", 32, 32, 32), 32);
     let mut r =
         isr::renderer::Renderer::new(&gpu, &scene, &voxels(sized("none", 32, 32, 32), 32)).unwrap();
-    assert!(
-        r.visibility_grid().is_none(),
-        "direct light alone reads no grid"
-    );
+    assert!(r.voxel_grid().is_none(), "direct light alone reads no grid");
     r.render_frames(1, |_| {}).unwrap();
     r.set_method_settings(&hisr).unwrap();
-    assert!(r.visibility_grid().is_some());
+    assert!(r.voxel_grid().is_some());
     r.render_frames(1, |_| {}).unwrap();
     let switched = r.readback().unwrap();
     drop(r);
@@ -503,7 +497,7 @@ fn a_grid_past_the_devices_storage_buffer_range_is_refused_before_allocation() {
     // than the 128 MiB lavapipe binds in one storage buffer: the run is
     // refused with the grid that fits, before anything is allocated
     // (validation would report the binding).
-    use isr::passes::visibility_grid::grid_bytes;
+    use isr::voxel_grid::grid_bytes;
     let gpu = validating_gpu();
     let range = gpu.limits().max_storage_buffer_range as u64;
     let scene = cornell_at_rest(false);

@@ -1,4 +1,4 @@
-//! The voxel grid's voxelization (pass `visibility-grid`,
+//! The voxel grid's voxelization (pass `voxel-grid`,
 //! `shaders/voxel_grid/voxelize.comp`; docs/algorithm.md section 5, "Voxel
 //! visibility") against a separating-axis test written here, on triangles
 //! of every size and orientation: the large ones that whole workgroups
@@ -9,8 +9,8 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Mat4, Quat, Vec3};
-use isr::passes::visibility_grid::{GRID, SUBCELLS};
 use isr::scene::{Camera, GpuVertex, Scene};
+use isr::voxel_grid::{GRID, SUBCELLS};
 
 /// A fixed pseudo-random sequence in [0, 1) (64-bit LCG).
 struct Lcg(u64);

@@ -18,7 +18,7 @@ const float SHARED_REACH = 4.0;
 // grazing angle, a tile's corners under a disc and its receivers beyond
 // the umbra), sees other occluders.
 float tile_point_weight(vec3 xi, vec3 n, vec3 xk, vec3 nk) {
-    float cell = u.visibility_grid.w;
+    float cell = u.grid_cube.w;
     float plane = abs(dot(nk, xi - xk)) / cell;
     float apart = length(xi - xk) / cell;
     return (1.0 - smoothstep(0.5, 1.0, plane)) * smoothstep(0.8, 0.9, dot(n, nk))

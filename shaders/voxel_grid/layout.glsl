@@ -14,7 +14,7 @@
 #include "frame.glsl"
 
 // Sub-cells per side of a finest cell: 1, 2 or 4 (`--visibility-subcells`,
-// passes::visibility_grid::specialization, which every pipeline that
+// visibility::specialization, which every pipeline that
 // includes this file is made with).
 layout(constant_id = 21) const int GRID_SUB = 4;
 
@@ -23,7 +23,7 @@ layout(constant_id = 21) const int GRID_SUB = 4;
 // 1/8; every level has at least 4^3 cells: whole, even counts of words); with
 // sub-cells, level 0's masks take 2 N^3 words.
 uint grid_level_offset(int k) {
-    uint n = uint(run.visibility_side);
+    uint n = uint(run.grid_side);
     uint h = n >> 1u, m = n >> uint(k);
     if (GRID_SUB == 1) return (n * n * n - m * m * m) / 28u;
     return k == 0 ? 0u : 2u * n * n * n + (h * h * h - m * m * m) / 28u;
@@ -32,7 +32,7 @@ uint grid_level_offset(int k) {
 // Cell c's index within level k (side N >> k, a power of 2: shifts, not
 // multiplies, which the march does at every step).
 uint grid_cell_index(int k, ivec3 c) {
-    int s = findMSB(run.visibility_side) - k;
+    int s = findMSB(run.grid_side) - k;
     return uint(c.x | (c.y << s) | (c.z << (2 * s)));
 }
 

@@ -11,8 +11,8 @@
 #include "voxel_grid/layout.glsl"
 layout(local_size_x = 64) in;
 
-layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
-layout(push_constant) uniform Push { VisibilityGridLevelPush push; };
+layout(set = 0, binding = 3, std430) buffer GridOccupancy { uint visibility_bits[]; };
+layout(push_constant) uniform Push { GridLevelPush push; };
 
 bool occupied(int k, ivec3 c) {
     if (k == 0 && GRID_SUB > 1) {
@@ -33,7 +33,7 @@ uint even_bits(uint x) {
 
 void main() {
     int k = push.level;  // the level read; k + 1 is written
-    int n = run.visibility_side >> (k + 1);
+    int n = run.grid_side >> (k + 1);
     uint word = gl_GlobalInvocationID.x;
     uint cells = uint(n * n * n);
     if (word >= cells / 32u) return;

@@ -2,7 +2,7 @@
 // section 5, "Voxel visibility"): whether the segment from a receiver to a
 // light patch crosses an occupied cell. The grid is this frame's posed
 // scene, conservatively voxelized by voxel_grid/voxelize.comp: N^3 finest cells
-// over the cube u.visibility_grid, and OR-levels k = 1.. of side N >> k
+// over the cube u.grid_cube, and OR-levels k = 1.. of side N >> k
 // (a level-k cell is occupied iff one of its 8^k finest cells is:
 // voxel_grid/levels.comp), laid out as voxel_grid/layout.glsl says.
 #ifndef VISIBILITY_GLSL
@@ -11,7 +11,7 @@
 
 // Read two words at a time: a finest cell's sub-cell mask, or the pair of
 // words that holds a coarser cell's bit (voxel_grid/layout.glsl).
-layout(set = 0, binding = 3, std430) readonly buffer VisibilityGrid { uvec2 visibility_pairs[]; };
+layout(set = 0, binding = 3, std430) readonly buffer GridOccupancy { uvec2 visibility_pairs[]; };
 
 // The parts of the segment nearer than this to the receiver's tangent plane
 // (in finest cells) are not marched: the sub-cells a plane touches lie within
@@ -71,7 +71,7 @@ const int VISIBILITY_SAMPLES = 4;
 // sub-cells; after leaving a cell the march climbs a level only where it also
 // left the parent cell.
 float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
-    vec4 g = u.visibility_grid;
+    vec4 g = u.grid_cube;
     vec3 a = (xi - g.xyz) / g.w;  // in finest cells
     vec3 d = (xj - xi) / g.w;
     float rise_i = dot(d, ni);    // the patch's height over the receiver's plane
@@ -83,7 +83,7 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
     vec3 ds = mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
     vec3 inv = 1.0 / ds;
     // Only the grid's inside holds occluders.
-    float side = float(run.visibility_side);
+    float side = float(run.grid_side);
     vec3 ta = -a * inv, tb = (vec3(side) - a) * inv;
     vec3 tin = min(ta, tb), tout = max(ta, tb);
     t0 = max(t0, max(tin.x, max(tin.y, tin.z)));
@@ -92,12 +92,12 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
     vec3 a_inv = a * inv;          // a cell face f is left at t = f inv - a_inv
     float seg = length(d);         // the segment's length in cells
     float eps = 1e-3 / seg;        // a thousandth of a cell along the segment
-    int top = run.visibility_levels - 1;
+    int top = run.grid_levels - 1;
     // Start one level up: the march starts near the receiver's surface,
     // where the coarse cells are occupied (it climbs as it leaves parents).
     int k = min(1, top);
     float t = t0;
-    ivec3 last_cell = ivec3(run.visibility_side - 1);
+    ivec3 last_cell = ivec3(run.grid_side - 1);
     float inside = 0.0;  // the segment's length inside occupied finest cells
     bool going = t < t1;
     // The finest cell at t: found once per advance, and kept while the march

@@ -17,7 +17,7 @@
 // axes edge x box-axis are tested per cell, except where the column lies
 // inside the triangle's outline, where they cannot separate (mark_column).
 //
-// Who marks what (visibility_grid.rs): each mesh's triangles are ordered
+// Who marks what (voxel_grid/voxelize.rs): each mesh's triangles are ordered
 // largest first (TriangleOrder), and each frame the large ones of each
 // instance, those that may span more than 64 sub-cells a side (walls,
 // floors), are marked by a dispatch of this shader with LARGE true, in which
@@ -37,11 +37,11 @@
 #include "voxel_grid/layout.glsl"
 layout(local_size_x = 64) in;
 
-// Cleared before the dispatch (visibility_grid.rs).
-layout(set = 0, binding = 3, std430) buffer VisibilityGrid { uint visibility_bits[]; };
+// Cleared before the dispatch (voxel_grid/voxelize.rs).
+layout(set = 0, binding = 3, std430) buffer GridOccupancy { uint visibility_bits[]; };
 layout(set = 1, binding = 0, std430) readonly buffer Vertices { float vertex_data[]; };  // GpuVertex: 8 floats
 layout(set = 1, binding = 1, std430) readonly buffer Indices { uint index_data[]; };
-layout(push_constant) uniform Push { VisibilityGridPush draw; };
+layout(push_constant) uniform Push { VoxelizePush draw; };
 
 // In cells: covers float error in the corners and faces the tests compare.
 const float MARGIN = 1e-3;
@@ -109,7 +109,7 @@ Columns columns_of(vec3 a, vec3 b, vec3 c, out uint count) {
     t.a = a;
     t.b = b;
     t.c = c;
-    int n = run.visibility_side * GRID_SUB;
+    int n = run.grid_side * GRID_SUB;
     vec3 lo = min(a, min(b, c)) - MARGIN, hi = max(a, max(b, c)) + MARGIN;
     bool outside = any(lessThan(hi, vec3(0.0))) || any(greaterThanEqual(lo, vec3(float(n))));
     vec3 an = abs(cross(b - a, c - a));
@@ -183,13 +183,13 @@ void mark_column(Columns t, int cu, int cv) {
     }
 }
 
-// Which triangles this dispatch marks (visibility_grid.rs): the large ones,
+// Which triangles this dispatch marks (voxel_grid/voxelize.rs): the large ones,
 // those whose bounding box can span more than a few sub-cells a side, each
 // by the whole workgroup, or the others, each by its own invocation.
 layout(constant_id = 22) const bool LARGE = false;
 
 // The mesh's triangles, largest first: each the position of its first index
-// in Indices (visibility_grid.rs, `TriangleOrder`), at the same place as the
+// in Indices (voxel_grid/voxelize.rs, `TriangleOrder`), at the same place as the
 // triangle's own (a draw's first index / 3 on).
 layout(set = 1, binding = 2, std430) readonly buffer Order { uint triangle_order[]; };
 
@@ -201,7 +201,7 @@ shared vec3 large_a[64], large_b[64], large_c[64];
 bool load_triangle(uint t, out vec3 a, out vec3 b, out vec3 c) {
     uint first = triangle_order[draw.first_index / 3u + draw.first_triangle + t];
     mat4 m = transforms[draw.instance].world_from_object;
-    vec4 g = u.visibility_grid;
+    vec4 g = u.grid_cube;
     float per = float(GRID_SUB) / g.w;  // sub-cells per unit of length
     a = ((m * vec4(vertex_position(index_data[first]), 1.0)).xyz - g.xyz) * per;
     b = ((m * vec4(vertex_position(index_data[first + 1u]), 1.0)).xyz - g.xyz) * per;
@@ -215,7 +215,7 @@ void main() {
     vec3 a, b, c;
     bool area = t < draw.triangles && load_triangle(t, a, b, c);
     if (!LARGE) {
-        // A small triangle: its few columns (visibility_grid.rs bounds them).
+        // A small triangle: its few columns (voxel_grid/voxelize.rs bounds them).
         if (!area) return;
         uint count;
         Columns s = columns_of(a, b, c, count);
@@ -228,7 +228,7 @@ void main() {
     // The workgroup's (up to) 64 large triangles, one after another, each
     // shared by its 64 invocations and by the dispatch's y rows of
     // workgroups: this invocation takes every (64 y)-th column from its own.
-    // visibility_grid.rs makes y large enough that none takes more than 128
+    // voxel_grid/voxelize.rs makes y large enough that none takes more than 128
     // columns of one: lavapipe ends an invocation's loops after 65,535
     // iterations together.
     uint i = gl_LocalInvocationIndex;

@@ -408,7 +408,7 @@ pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
 /// The passes' colours: Kelly's colours of maximum contrast (less white) and
 /// four more, at least one for each pass a full bench draws (22), so that
 /// neighbouring passes in a bar stay apart (with `Palette99`,
-/// `visibility-grid` and `composite` came out alike).
+/// `voxel-grid` and `composite` came out alike).
 const PASS_COLOURS: [(u8, u8, u8); 24] = [
     (0xF3, 0xC3, 0x00),
     (0x87, 0x56, 0x92),

@@ -18,9 +18,9 @@ pub mod truth;
 mod truth_cache;
 pub mod visibility;
 
-use crate::passes::visibility_grid::Visibility;
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
+use crate::visibility::Visibility;
 use crate::vk::{Gpu, GpuOptions};
 use anyhow::{bail, Context as _, Result};
 use measure::{run_scene, Pending};
@@ -260,7 +260,7 @@ impl BenchArgs {
             ..RenderSettings::DEFAULT
         };
         let grid_used = visibilities.contains(&Visibility::Voxels);
-        if let Some(w) = crate::passes::visibility_grid::unused_grid_warning(&base, grid_used) {
+        if let Some(w) = crate::visibility::unused_grid_warning(&base, grid_used) {
             eprintln!("{w}");
         }
         // Each pass sets its own (`Plan::passes`); a grid out of range is
@@ -268,7 +268,7 @@ impl BenchArgs {
         let base = visibility::with(&base, Visibility::None);
         if visibilities.contains(&Visibility::Voxels) {
             use crate::settings::params::AnyParam as _;
-            crate::passes::visibility_grid::GRID.check(&base)?;
+            crate::voxel_grid::GRID.check(&base)?;
         }
         Ok(Plan {
             scenes: specs,
@@ -314,7 +314,7 @@ impl Plan {
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         // With the voxel grid on (`--visibility voxels`), rows are kept
         // apart from a run's without it, so both can share a directory.
-        let visibility = match crate::passes::visibility_grid::uses_voxels(b) {
+        let visibility = match crate::visibility::uses_voxels(b) {
             true => format!("|{}", visibility::label(b)),
             false => String::new(),
         };

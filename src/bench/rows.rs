@@ -189,7 +189,8 @@ impl Row {
 /// visibility's: a row's `visibility` column says it (`voxels 64`), in every
 /// row, where theirs would be empty for the methods that read none.
 pub fn param_names(rows: &[Row]) -> Vec<String> {
-    use crate::passes::visibility_grid::{GRID, VISIBILITY};
+    use crate::visibility::VISIBILITY;
+    use crate::voxel_grid::GRID;
     let mut names: Vec<String> = vec![];
     for r in rows {
         for n in r.params.keys() {

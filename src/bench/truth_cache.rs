@@ -40,7 +40,8 @@ pub(super) fn model_floor(
             k + 1
         ))
     };
-    let exact = crate::visibility::with_exact_visibility(r, posed, out.clone(), 1.0, message)?;
+    let exact =
+        crate::exact_visibility::with_exact_visibility(r, posed, out.clone(), 1.0, message)?;
     write_exact(&path, &exact, time, plan.base.rsm_resolution)?;
     if bar.is_hidden() {
         eprintln!(

@@ -9,8 +9,9 @@
 
 use super::rows::Row;
 use super::Plan;
-use crate::passes::visibility_grid::{Visibility, GRID, SUBCELLS, VISIBILITY};
 use crate::settings::{Method, RenderSettings};
+use crate::visibility::{Visibility, VISIBILITY};
+use crate::voxel_grid::{GRID, SUBCELLS};
 use anyhow::{bail, Result};
 
 /// What `isr bench --visibility` takes; `exact` is refused by [`parse`].

@@ -322,9 +322,7 @@ fn render(args: RenderArgs) -> Result<()> {
     // The settings' own checks need no device: they fail before it starts.
     crate::frame::check::check_ranges(&settings)?;
     crate::methods::check(&settings)?;
-    use crate::passes::visibility_grid::{
-        unused_grid_warning, uses_voxels, Visibility, VISIBILITY,
-    };
+    use crate::visibility::{unused_grid_warning, uses_voxels, Visibility, VISIBILITY};
     if let Some(w) = unused_grid_warning(&settings, uses_voxels(&settings)) {
         eprintln!("{w}");
     }
@@ -398,7 +396,7 @@ fn render(args: RenderArgs) -> Result<()> {
         // The indirect layer again on the CPU, each VPL tested for each pixel.
         let bar = crate::progress::bar(result.height as u64, "rows");
         bar.set_message("exact visibility");
-        result = crate::visibility::with_exact_visibility(
+        result = crate::exact_visibility::with_exact_visibility(
             &mut renderer,
             &state.pose(&scene),
             result,

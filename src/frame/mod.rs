@@ -52,7 +52,7 @@ pub struct FrameContext<'a> {
 /// and the instance transforms (host-visible, written before the frame is
 /// submitted, after the previous frame that used them has finished), and the
 /// frame set that binds them with the run's fixed uniforms and the voxel
-/// visibility grid (`passes::visibility_grid`; one grid for every frame set,
+/// voxel grid (`voxel_grid`; one grid for every frame set,
 /// rebuilt by each frame on the GPU behind a barrier).
 pub struct FrameSet {
     pub uniforms: Buffer,
@@ -83,7 +83,7 @@ impl FrameSet {
                 Binding::uniform("Frame", &uniforms),
                 Binding::uniform("Run", run),
                 Binding::storage("Transforms", &transforms),
-                Binding::storage("VisibilityGrid", grid),
+                Binding::storage("GridOccupancy", grid),
             ],
         )?;
         Ok(Self {

@@ -110,7 +110,7 @@ impl SceneGpu {
             .map(|t| upload_texture(gpu, t))
             .collect::<Result<Vec<_>>>()?;
         // Storage too: the visibility grid's voxelization reads the triangles
-        // (`passes::visibility_grid`).
+        // (`voxel_grid`).
         let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
         let vertices = Buffer::with_data(gpu, "vertices", bytemuck::cast_slice(&vertices), usage)?;
         let usage = vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;

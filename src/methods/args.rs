@@ -69,7 +69,7 @@ macro_rules! param_args {
 param_args!(ParamArgs, &[]);
 param_args!(
     ParamArgsButVisibility,
-    &[crate::passes::visibility_grid::VISIBILITY.name]
+    &[crate::visibility::VISIBILITY.name]
 );
 
 /// The values given in `m` of every parameter but those in `except`.

@@ -58,7 +58,7 @@ impl GatherPass {
             .filter(|_| source == LightPatches::TiledTraversal);
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
         let stencil = crate::multires::STENCIL.get(setup.settings);
-        let visibility = crate::passes::visibility_grid::specialization(setup.settings);
+        let visibility = crate::visibility::specialization(setup.settings);
         let pipeline = PassPipeline::graphics(
             gpu,
             setup.frame,

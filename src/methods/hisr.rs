@@ -16,7 +16,7 @@ use crate::gpu_types::{
     HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS, HISR_TAU_ABSOLUTE, HISR_TAU_RELATIVE,
 };
 use crate::multires;
-use crate::passes::{rsm_tree, visibility_grid, ComputePass, INDIRECT_COMPUTE};
+use crate::passes::{rsm_tree, ComputePass, INDIRECT_COMPUTE};
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::barrier;
@@ -176,7 +176,7 @@ pub fn unused_sharing_warning(s: &RenderSettings) -> Option<String> {
 
 /// Whether `hisr-visibility` runs: with the grid, tiles, and sharing on.
 pub fn shares_visibility(s: &RenderSettings) -> bool {
-    visibility_grid::uses_voxels(s) && TILE_LEVEL.get(s) > 0 && SHARED_VISIBILITY.get(s)
+    crate::visibility::uses_voxels(s) && TILE_LEVEL.get(s) > 0 && SHARED_VISIBILITY.get(s)
 }
 
 /// T at the finest level for `tau` given as a fraction of the light's peak
@@ -447,7 +447,7 @@ impl CutPass {
                         "REFINE_SPREAD",
                         SHARED_REFINE.get(setup.settings),
                     ),
-                    crate::passes::visibility_grid::specialization(setup.settings)[1],
+                    crate::voxel_grid::specialization(setup.settings),
                 ],
             )?),
             false => None,

@@ -29,11 +29,11 @@ pub mod vpls;
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
 use crate::multires::{self, MultiresBuffer};
-use crate::passes::visibility_grid;
 use crate::settings::params::AnyParam;
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
 use crate::vk::Buffer;
+use crate::{visibility, voxel_grid};
 use anyhow::{anyhow, bail, Result};
 pub use args::{ParamArgs, ParamArgsButVisibility};
 
@@ -87,7 +87,7 @@ pub trait Descriptor: Sync {
     /// Whether it evaluates the patch formula (`patch_irradiance`,
     /// `shaders/vpl.glsl`) and so takes its visibility term:
     /// `--visibility` and `--visibility-grid` then come with it, the voxel
-    /// grid's memory and uniforms too (`passes::visibility_grid`).
+    /// grid's memory and uniforms too (`visibility`, `voxel_grid`).
     fn reads_visibility(&self) -> bool {
         false
     }
@@ -214,7 +214,7 @@ pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyPar
         &[]
     };
     let visibility: &[&dyn AnyParam] = if d.reads_visibility() {
-        visibility_grid::PARAMS
+        visibility::PARAMS
     } else {
         &[]
     };
@@ -237,7 +237,10 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
     // The grid is made for the run whenever `--visibility voxels` is set
     // (the viewer may switch to a method that reads it), so it counts
     // whatever the method.
-    let grid = visibility_grid::memory(s);
+    let grid = match visibility::uses_voxels(s) {
+        true => voxel_grid::VoxelGrid::bytes(s),
+        false => 0,
+    };
     multires + grid + d.memory(s)
 }
 
@@ -251,7 +254,7 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
         vpls::RegularVpls::of(s).write_uniforms(s, u);
     }
     if d.reads_visibility() {
-        visibility_grid::write_uniforms(s, u);
+        voxel_grid::write_uniforms(s, u);
     }
     d.write_uniforms(s, u);
 }
@@ -287,7 +290,7 @@ pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
         vpls::check(s)?;
     }
     if d.reads_visibility() {
-        visibility_grid::check(s, d.key().name(), d.takes_exact_visibility())?;
+        visibility::check(s, d.key().name(), d.takes_exact_visibility())?;
     }
     d.check(s)?;
     Ok(d)

@@ -86,7 +86,7 @@ impl MultiresSplatPass {
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::EQUAL_ONE),
                 blend: Blend::AdditiveAlphaMax,
-                specialization: &crate::passes::visibility_grid::specialization(setup.settings),
+                specialization: &crate::visibility::specialization(setup.settings),
                 ..Default::default()
             },
         )?;

@@ -21,10 +21,10 @@ use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
-use crate::passes::visibility_grid;
 use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, RenderSettings};
+use crate::visibility;
 use crate::vk::barrier::{self, Use};
 use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
 use crate::vk::profiler::Profiler;
@@ -104,18 +104,17 @@ impl Reference {
                 push_constant_bytes: 8,
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &crate::passes::visibility_grid::specialization(s),
+                specialization: &crate::visibility::specialization(s),
                 ..Default::default()
             },
         )?;
         let total = RegularVpls::every_texel(s).count;
         let pixels = s.width as u64 * s.height as u64;
         let mut per_chunk = (CHUNK.get(s).max(1) / pixels).clamp(1, total as u64) as u32;
-        if visibility_grid::uses_voxels(s) {
+        if visibility::uses_voxels(s) {
             // A fragment's marches through the grid within lavapipe's loop
-            // limit (`visibility_grid::LOOP_BUDGET`).
-            let most =
-                visibility_grid::LOOP_BUDGET / visibility_grid::LOOP_ITERATIONS_PER_EVALUATION;
+            // limit (`visibility::LOOP_BUDGET`).
+            let most = visibility::LOOP_BUDGET / visibility::LOOP_ITERATIONS_PER_EVALUATION;
             per_chunk = per_chunk.min(most as u32);
         }
         let chunks = (0..total.div_ceil(per_chunk))

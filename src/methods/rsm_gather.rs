@@ -63,7 +63,7 @@ impl RsmGather {
             INDIRECT_GRAPHICS,
             (
                 "rsm_gather/gather.frag",
-                &crate::passes::visibility_grid::specialization(setup.settings),
+                &crate::visibility::specialization(setup.settings),
             ),
             &full_resolution_bindings(setup),
             8,

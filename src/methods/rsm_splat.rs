@@ -107,7 +107,7 @@ impl RsmSplat {
     /// `restricted`: quads bounded by `--splat-threshold` (else full screen).
     pub fn new(setup: &Setup, restricted: bool) -> Result<Self> {
         let format = setup.targets.indirect.format;
-        let visibility = crate::passes::visibility_grid::specialization(setup.settings);
+        let visibility = crate::visibility::specialization(setup.settings);
         require_blending(setup.gpu, format, "rsm-splat")?;
         let pipeline = PassPipeline::graphics(
             setup.gpu,

@@ -25,7 +25,6 @@ pub mod rsm;
 pub mod rsm_cube;
 pub mod rsm_tree;
 pub mod tonemap;
-pub mod visibility_grid;
 
 use crate::frame::{FrameContext, SceneGpu, Setup, Targets};
 use crate::vk::barrier::{self, Use};

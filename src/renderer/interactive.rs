@@ -106,7 +106,7 @@ impl<'g> Renderer<'g> {
         )?;
         // The grid is made with the run (the frame sets bind it).
         let grid_in_use = reads_grid(descriptor, settings);
-        let grid = crate::passes::visibility_grid::GRID;
+        let grid = crate::voxel_grid::GRID;
         if grid_in_use
             && (self.visibility_pass.is_none() || grid.get(settings) != grid.get(&self.settings))
         {

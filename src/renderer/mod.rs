@@ -18,12 +18,13 @@ use crate::methods::{Descriptor, IndirectMethod};
 use crate::passes::light_sum::{LightSumPass, SumStep};
 use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::{self, RsmTreePass};
-use crate::passes::visibility_grid::{self, VisibilityGridPass};
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::scene::{FrameState, LightKind, Scene};
 use crate::settings::RenderSettings;
 use crate::view::LightView;
+use crate::visibility;
 use crate::vk::profiler::{PassSample, Profiler};
+use crate::voxel_grid::{self, VoxelGrid, VoxelizePass};
 
 mod interactive;
 mod results;
@@ -77,9 +78,9 @@ pub struct Renderer<'g> {
     /// Renders only this view (tests look at one cube face's RSM).
     only_view: Option<usize>,
     light_sum: Option<LightSumPass>,
-    /// Pass `visibility-grid`, made when the run asks for `--visibility
+    /// Pass `voxel-grid`, made when the run asks for `--visibility
     /// voxels`, and whether the current method reads it (`grid_in_use`).
-    visibility_pass: Option<VisibilityGridPass>,
+    visibility_pass: Option<VoxelizePass>,
     grid_in_use: bool,
     /// Point lights' layered cube RSM (made only when the scene has one).
     rsm_cube: Option<CubeRsmPass>,
@@ -97,7 +98,7 @@ pub struct Renderer<'g> {
     run_uniforms: (Buffer, RunUniforms),
     /// The voxel visibility grid every frame set binds (16 bytes without
     /// `--visibility voxels`).
-    visibility_grid: Buffer,
+    voxel_grid: VoxelGrid,
     pub scene: SceneGpu,
     pub targets: Targets,
     _samplers: Samplers,
@@ -144,8 +145,13 @@ impl<'g> Renderer<'g> {
         // The slots' profilers are sized once the method says how many
         // submissions (repeated passes) its frames take, so the method comes
         // first, made with a provisional frame set of the same layout.
-        let visibility_grid = visibility_grid::grid_buffer(gpu, settings)?;
-        let first = FrameSet::new(gpu, &run_uniforms, &visibility_grid, scene.instances.len())?;
+        let voxel_grid = VoxelGrid::new(gpu, settings, visibility::uses_voxels(settings))?;
+        let first = FrameSet::new(
+            gpu,
+            &run_uniforms,
+            &voxel_grid.occupancy,
+            scene.instances.len(),
+        )?;
         let setup = Setup {
             gpu,
             frame: &first.set,
@@ -174,8 +180,8 @@ impl<'g> Renderer<'g> {
         // Made with `--visibility voxels` whatever the method, so that the
         // viewer can switch to one that reads it; recorded only for those.
         let grid_in_use = reads_grid(descriptor, settings);
-        let visibility_pass = match visibility_grid::uses_voxels(settings) {
-            true => Some(VisibilityGridPass::new(&setup, &visibility_grid, scene)?),
+        let visibility_pass = match visibility::uses_voxels(settings) {
+            true => Some(VoxelizePass::new(&setup, &voxel_grid, scene)?),
             false => None,
         };
         drop(first);
@@ -184,7 +190,7 @@ impl<'g> Renderer<'g> {
             .map(|_| {
                 Slot::new(
                     gpu,
-                    (&run_uniforms, &visibility_grid),
+                    (&run_uniforms, &voxel_grid.occupancy),
                     scene.instances.len(),
                     views.len(),
                     passes,
@@ -215,7 +221,7 @@ impl<'g> Renderer<'g> {
             next_slot: 0,
             frames_submitted: 0,
             run_uniforms: (run_uniforms, run_values),
-            visibility_grid,
+            voxel_grid,
             scene: scene_gpu,
             targets,
             _samplers: samplers,
@@ -267,28 +273,28 @@ impl<'g> Renderer<'g> {
     pub fn view_uniforms(&self, v: usize) -> FrameUniforms {
         let bounds = relative(self.bounds, self.origin);
         let mut u = frame_uniforms(&self.state, &self.settings, &self.views[v], bounds);
-        u.visibility_grid = self.visibility_cube();
+        u.grid_cube = self.grid_cube();
         u
     }
 
     /// The voxel visibility grid's cube around the posed scene of the
     /// current frame state (relative to the render origin).
-    pub fn visibility_cube(&self) -> [f32; 4] {
+    pub fn grid_cube(&self) -> [f32; 4] {
         let boxes = self
             .object_bounds
             .iter()
             .zip(&self.state.instance_transforms)
             .map(|(b, m)| crate::view::transformed_box(m, *b));
-        visibility_grid::grid_cube(
+        voxel_grid::grid_cube(
             boxes,
-            visibility_grid::GRID.get(&self.settings),
-            visibility_grid::SUBCELLS.get(&self.settings),
+            voxel_grid::GRID.get(&self.settings),
+            voxel_grid::SUBCELLS.get(&self.settings),
         )
     }
 
     /// The voxel visibility grid's buffer (its bits, `shaders/voxel_grid/march.glsl`).
-    pub fn visibility_grid(&self) -> Option<&Buffer> {
-        self.grid_in_use.then_some(&self.visibility_grid)
+    pub fn voxel_grid(&self) -> Option<&Buffer> {
+        self.grid_in_use.then_some(&self.voxel_grid.occupancy)
     }
 
     /// The RSMs each frame renders, in order.
@@ -359,7 +365,7 @@ impl<'g> Renderer<'g> {
                 view.face.filter(|_| first).map(|_| view.light as u32)
             })
             .collect();
-        let cube = self.visibility_cube();
+        let cube = self.grid_cube();
         let Self {
             slots,
             method,
@@ -564,7 +570,7 @@ fn check_run(
     let d = crate::methods::check(settings)?;
     let method = crate::methods::memory(d, settings);
     check_settings(gpu, settings, method)?;
-    crate::passes::visibility_grid::check_device(gpu, settings)?;
+    crate::voxel_grid::check_device(gpu, settings)?;
     let cube_rsm = match lights.iter().any(|l| l.kind == LightKind::Point) {
         true => crate::passes::rsm_cube::cube_bytes(settings.rsm_resolution),
         false => 0,
@@ -581,7 +587,7 @@ fn check_run(
 
 /// Whether a run of `d` with `s` reads the voxel visibility grid.
 fn reads_grid(d: &dyn Descriptor, s: &RenderSettings) -> bool {
-    d.reads_visibility() && visibility_grid::uses_voxels(s)
+    d.reads_visibility() && visibility::uses_voxels(s)
 }
 
 /// The run uniforms of `s`: the shared fields, the RSM tree's, then the

@@ -10,7 +10,7 @@ use isr::vk::Gpu;
 
 /// The voxel grid after one frame of `scene` with `settings` (which use it):
 /// its words as read back (`shaders/voxel_grid/layout.glsl`), its cube
-/// (`Renderer::visibility_cube`, relative to the render origin) and the
+/// (`Renderer::grid_cube`, relative to the render origin) and the
 /// render origin. Fails the test if validation spoke.
 pub fn rendered_grid(
     gpu: &Gpu,
@@ -19,10 +19,10 @@ pub fn rendered_grid(
 ) -> (Vec<u32>, [f32; 4], DVec3) {
     let mut r = Renderer::new(gpu, scene, settings).expect("renderer setup");
     r.render_frames(1, |_| {}).expect("rendering");
-    let grid = r.visibility_grid().expect("a run with the voxel grid");
+    let grid = r.voxel_grid().expect("a run with the voxel grid");
     let words =
         bytemuck::cast_slice(&isr::readback::read_buffer(gpu, grid).expect("readback")).to_vec();
-    let (cube, origin) = (r.visibility_cube(), r.render_origin());
+    let (cube, origin) = (r.grid_cube(), r.render_origin());
     drop(r);
     assert_validation_clean(gpu);
     (words, cube, origin)
@@ -30,7 +30,8 @@ pub fn rendered_grid(
 
 /// `s` with `--visibility voxels` at grid side `n`.
 pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
-    use isr::passes::visibility_grid::{Visibility, GRID, VISIBILITY};
+    use isr::visibility::{Visibility, VISIBILITY};
+    use isr::voxel_grid::GRID;
     VISIBILITY.set(&mut s, Visibility::Voxels);
     GRID.set(&mut s, n);
     s
@@ -39,7 +40,7 @@ pub fn voxels(mut s: RenderSettings, n: u32) -> RenderSettings {
 /// `s` with the plain grid: one bit per finest cell, no sub-cells
 /// (`--visibility-subcells 1`).
 pub fn plain_grid(mut s: RenderSettings) -> RenderSettings {
-    isr::passes::visibility_grid::SUBCELLS.set(&mut s, 1);
+    isr::voxel_grid::SUBCELLS.set(&mut s, 1);
     s
 }
 

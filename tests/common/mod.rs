@@ -332,8 +332,8 @@ pub fn disc(s: &mut Scene, m: usize, y: f32, r: f32) {
 }
 
 /// A VPL at `p` facing down (the visibility tests' light).
-pub fn down(p: Vec3, flux: f32) -> isr::visibility::Vpl {
-    isr::visibility::Vpl {
+pub fn down(p: Vec3, flux: f32) -> isr::exact_visibility::Vpl {
+    isr::exact_visibility::Vpl {
         position: p,
         normal: -Vec3::Y,
         flux: Vec3::splat(flux),

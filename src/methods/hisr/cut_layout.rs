@@ -138,8 +138,8 @@ fn header_bytes(header: &HisrCutHeader) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::passes::visibility_grid::{Visibility, VISIBILITY};
     use crate::settings::Method;
+    use crate::visibility::{Visibility, VISIBILITY};
 
     fn hisr(width: u32, height: u32, grid: bool) -> RenderSettings {
         let mut s = RenderSettings {

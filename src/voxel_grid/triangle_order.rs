@@ -1,4 +1,4 @@
-//! Each mesh's triangles ordered largest first, for pass `visibility-grid`
+//! Each mesh's triangles ordered largest first, for pass `voxel-grid`
 //! to hand its large triangles to whole workgroups and the rest to one
 //! invocation each (`shaders/voxel_grid/voxelize.comp`; docs/algorithm.md
 //! section 5, "Voxel visibility").
