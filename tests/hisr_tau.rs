@@ -138,8 +138,9 @@ fn relative_tau_gives_like_errors_on_differently_lit_scenes() {
 
 /// The relative tau bounds the error for every light type: at tau 0.02 the
 /// box's spot, point light (six cube faces) and directional light each give
-/// an error below tau and above tau / 10 (measured: 0.49%, 0.61% and 0.35%;
-/// the spread between light types, 1.75x, is printed, not held).
+/// an error below tau (the guarantee), and each error is the one measured,
+/// 0.491%, 0.605% and 0.345%, within 10% (a regression value; the spread
+/// between light types, 1.75x, is printed, not held).
 #[test]
 fn relative_tau_bounds_the_error_for_every_light_type() {
     let gpu = gpu();
@@ -162,7 +163,18 @@ fn relative_tau_bounds_the_error_for_every_light_type() {
     let lo = errors.iter().map(|e| e.1).fold(f64::MAX, f64::min);
     let hi = errors.iter().map(|e| e.1).fold(0.0, f64::max);
     println!("spread (largest error over smallest): {:.2}", hi / lo);
-    assert!(lo > tau as f64 / 10.0 && hi < tau as f64, "{errors:?}");
+    assert!(hi < tau as f64, "{errors:?} above tau {tau}");
+    // Margin 10%: the errors were the same to every digit in three runs
+    // and with LP_NUM_THREADS=0; moving tau itself by 2%, which flips far
+    // more refinement decisions than another driver's rounding could,
+    // moves them by 1.2% to 2.5%.
+    let measured = [0.004908, 0.006051, 0.003455];
+    for ((name, e), m) in errors.iter().zip(measured) {
+        assert!(
+            (e / m - 1.0).abs() < 0.1,
+            "{name}: error {e:.6} where {m} was measured"
+        );
+    }
 }
 
 /// The second-order patch kernel (docs/algorithm.md section 2.6): HISR's
