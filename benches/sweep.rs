@@ -25,6 +25,9 @@ fn main() -> anyhow::Result<()> {
         "{}",
         bench::ratios::ratios_text(&bench::ratios::ratios(&outcome.rows))
     );
-    println!("report: {}", plan.out_dir.join("report.md").display());
+    println!(
+        "report: {}",
+        plan.out_dir.join(bench::files::REPORT).display()
+    );
     Ok(())
 }

@@ -5,6 +5,7 @@ mod common;
 
 use common::cli::{Isr, Ran};
 use common::temp_dir;
+use isr::bench::files;
 use std::path::Path;
 
 fn bench(args: &[&str]) -> Ran {
@@ -116,28 +117,16 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     Isr::new("bench")
         .args(["--quick", "--out-dir", d])
         .succeeds();
-    for f in [
-        "results.json",
-        "results.csv",
-        "speed_vs_error.svg",
-        "speed_vs_error.png",
-        "speed_vs_truth.svg",
-        "speed_vs_truth.png",
-        "flicker.svg",
-        "flicker.png",
-        "passes.svg",
-        "passes.png",
-        "gallery.png",
-        "report.md",
-    ] {
-        let p = dir.join(f);
+    for f in files::written() {
+        let p = dir.join(&f);
         assert!(
             std::fs::metadata(&p).is_ok_and(|m| m.len() > 0),
             "{f} missing"
         );
     }
     let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.join(files::RESULTS_JSON)).unwrap())
+            .unwrap();
     let rows = json["rows"].as_array().unwrap();
     // Two scenes, each: the reference and every swept method's quick sweep
     // at the quick bench's RSM of 64 (from the registry: a new method
@@ -178,10 +167,10 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
             assert!(floor < t["rel_rmse_indirect"].as_f64().unwrap(), "{t}");
         }
     }
-    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let report = std::fs::read_to_string(dir.join(files::REPORT)).unwrap();
     assert!(report.contains("## Model error") && report.contains("RMSE truth"));
     errors_fall_as_the_cost_rises(rows);
-    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.join(files::RESULTS_CSV)).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
     for cell in csv.lines().skip(1).flat_map(|l| l.split(',')) {
         if let Ok(v) = cell.parse::<f64>() {
@@ -189,9 +178,9 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
         }
     }
     // A second run finds every row in the journal and renders nothing.
-    let journal = dir.join("rows.jsonl");
+    let journal = dir.join(files::JOURNAL);
     let before = lines(&journal);
-    let truth = dir.join("truth/slats/frame-2.exr");
+    let truth = files::truth_dir(&dir, "slats").join("frame-2.exr");
     let traced = std::fs::metadata(&truth).unwrap().modified().unwrap();
     Isr::new("bench")
         .args(["--quick", "--out-dir", d])
@@ -242,7 +231,8 @@ fn flicker_tells_64_vpls_from_4096_where_light_is_near_contact() {
         ])
         .succeeds();
     let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.join(files::RESULTS_JSON)).unwrap())
+            .unwrap();
     let rows = json["rows"].as_array().unwrap();
     let get = |scene: &str, vpls: &str, k: &str| -> f64 {
         rows.iter()
@@ -259,7 +249,7 @@ fn flicker_tells_64_vpls_from_4096_where_light_is_near_contact() {
             "{scene}: low-passed {low}, per pixel {pixel}"
         );
     }
-    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let report = std::fs::read_to_string(dir.join(files::REPORT)).unwrap();
     assert!(report.contains("## Flicker: 64 against 4096 regular VPLs"));
     assert!(report.contains("flicker of multires-gather 64 / multires-gather 4096"));
     std::fs::remove_dir_all(&dir).unwrap();
@@ -307,7 +297,7 @@ fn bad_names_list_the_valid_ones() {
     );
     let err = fails(&["--visibility", "voxels", "--visibility-grid", "48"]);
     assert!(err.contains("--visibility-grid 48"), "{err}");
-    assert!(!dir.join("rows.jsonl").exists());
+    assert!(!dir.join(files::JOURNAL).exists());
 }
 
 /// The visibility axis (issue 25 part 3), at 32x32 on the box with its
@@ -328,7 +318,7 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
             .args(["--visibility", visibility, "--out-dir", d])
             .succeeds();
         let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap())
+            serde_json::from_str(&std::fs::read_to_string(dir.join(files::RESULTS_JSON)).unwrap())
                 .unwrap();
         json["rows"].as_array().unwrap().clone()
     };
@@ -385,19 +375,20 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
         // Each against its own dense reference: near it, not near the other.
         assert!(b["rel_rmse_indirect"].as_f64().unwrap() < 0.1, "{b}");
     }
-    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.join(files::RESULTS_CSV)).unwrap();
     assert!(csv.starts_with("scene,method,visibility,label,"), "{csv}");
     assert!(csv.contains("\ncornell,hisr,voxels 64 sub 4,"), "{csv}");
-    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let report = std::fs::read_to_string(dir.join(files::REPORT)).unwrap();
     assert!(report.contains("## Indirect visibility: none against voxels 64"));
     assert!(report.contains("| cornell | hisr | tau "), "{report}");
-    let images = dir.join("images/cornell");
+    let images = files::images_dir(&dir, "cornell");
     assert!(
-        images.join("hisr-voxels.png").is_file() && images.join("reference-voxels.png").is_file()
+        images.join(files::image("hisr", "-voxels")).is_file()
+            && images.join(files::image("reference", "-voxels")).is_file()
     );
-    assert!(!images.join("lpv-voxels.png").exists());
+    assert!(!images.join(files::image("lpv", "-voxels")).exists());
     // A run without the grid into the same folder finds its rows there.
-    let journal = dir.join("rows.jsonl");
+    let journal = dir.join(files::JOURNAL);
     let before = lines(&journal);
     let rows = run("none");
     assert_eq!(lines(&journal), before);

@@ -1,30 +1,29 @@
 //! What HISR's `--tau` means (docs/algorithm.md section 4.3): with the
 //! relative tau (the default) the same tau gives about the same error
 //! against the dense gather on scenes lit very differently; the talk's
-//! absolute tau does not.
+//! absolute tau does not. The table of errors per bench scene and tau is a
+//! measurement, not a check: `cargo run --release --example hisr_tau`.
 mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::bench::scenes;
 use isr::methods::{hisr, vpls::VPLS};
 use isr::passes::rsm_tree::{PatchKernel, PATCH_KERNEL};
 use isr::renderer::Renderer;
 use isr::scene::{cornell::cornell_box, Scene};
 use isr::settings::{Method, RenderSettings};
 
-/// One render: the indirect image, the pixels with geometry, light patches
-/// per eye-space patch and the least indirect time of `frames` frames.
+/// One frame: the indirect image, the pixels with geometry and the light
+/// patches per eye-space patch.
 struct Measured {
     indirect: Vec<[f32; 4]>,
     mask: Vec<bool>,
     per_patch: f64,
-    ms: f64,
 }
 
-fn measure(gpu: &isr::vk::Gpu, scene: &Scene, s: &RenderSettings, frames: u32) -> Measured {
+fn measure(gpu: &isr::vk::Gpu, scene: &Scene, s: &RenderSettings) -> Measured {
     let mut r = Renderer::new(gpu, scene, s).expect("renderer setup");
-    let stats = r.render_frames(frames, |_| {}).expect("rendering");
+    r.render_frames(1, |_| {}).expect("rendering");
     let out = r.readback().expect("readback");
     let m = r.readback_multires().expect("readback").expect("multires");
     drop(r);
@@ -33,99 +32,6 @@ fn measure(gpu: &isr::vk::Gpu, scene: &Scene, s: &RenderSettings, frames: u32) -
         mask: geometry_mask(&out.position),
         indirect: out.indirect,
         per_patch: isr::debug_view::light_patch_stats(&m, None).per_patch_mean,
-        ms: stats.gpu_ms_min(true).unwrap_or(f64::NAN),
-    }
-}
-
-/// The table of docs/algorithm.md 4.3: on every bench scene at its bench
-/// size, HISR's error against the dense gather through the same eye-space
-/// patches at several taus, beside 4096 regular VPLs'. Not a check: run with
-/// `cargo test --release --test hisr_tau -- --ignored --nocapture`
-/// (`ISR_TAU_SCENES=a,b`, `ISR_TAU_TAUS=0.1,0.01`, `ISR_TAU_FRAMES=3`,
-/// `ISR_TAU_MODE=absolute`, `ISR_TAU_DEPTH=full`, `ISR_TAU_SIZE=64`,
-/// `ISR_TAU_KERNEL=centre`).
-#[test]
-#[ignore]
-fn table_of_errors_per_scene_and_tau() {
-    let gpu = gpu();
-    let names: Vec<String> = match std::env::var("ISR_TAU_SCENES") {
-        Ok(v) => v.split(',').map(str::to_string).collect(),
-        Err(_) => scenes::group("all")
-            .unwrap()
-            .into_iter()
-            .map(str::to_string)
-            .collect(),
-    };
-    let taus: Vec<f32> = std::env::var("ISR_TAU_TAUS")
-        .unwrap_or("0.2,0.05,0.01".into())
-        .split(',')
-        .map(|t| t.parse().unwrap())
-        .collect();
-    let frames: u32 = std::env::var("ISR_TAU_FRAMES")
-        .map(|v| v.parse().unwrap())
-        .unwrap_or(3);
-    // ISR_TAU_DEPTH=full: down to single RSM texels (log2 of the RSM), so
-    // that tau alone sets the error; else the default max depth.
-    let full = std::env::var("ISR_TAU_DEPTH").is_ok_and(|v| v == "full");
-    let kernel = match std::env::var("ISR_TAU_KERNEL").as_deref() {
-        Ok("centre") => PatchKernel::Centre,
-        _ => PatchKernel::SecondOrder,
-    };
-    let mode = match std::env::var("ISR_TAU_MODE").as_deref() {
-        Ok("absolute") => hisr::TauMode::Absolute,
-        _ => hisr::TauMode::Relative,
-    };
-    for name in names {
-        let bench = scenes::find(&name).unwrap();
-        let mut scene = scenes::build(&name).unwrap();
-        if !gpu.features.sampled_image_array_indexing {
-            isr::scene::one_texture::keep_one(&mut scene);
-        }
-        // The bench's image size and RSM, or ISR_TAU_SIZE for both.
-        let (size, rsm) = match std::env::var("ISR_TAU_SIZE") {
-            Ok(v) => (v.parse().unwrap(), v.parse().unwrap()),
-            Err(_) => bench.size.unwrap_or((128, 128)),
-        };
-        let at = |method: &'static str| {
-            RenderSettings {
-                method: Method::new(method),
-                ..sized("none", size, size, rsm)
-            }
-            .with(&PATCH_KERNEL, kernel)
-        };
-        let dense = measure(
-            &gpu,
-            &scene,
-            &at("multires-gather").with(&VPLS, rsm * rsm),
-            1,
-        );
-        let err = |m: &Measured| relative_rmse(&m.indirect, &dense.indirect, &dense.mask);
-        let v4096 = measure(
-            &gpu,
-            &scene,
-            &at("multires-gather").with(&VPLS, 4096),
-            frames,
-        );
-        println!(
-            "{name}: 4096 VPLs: error {:.5}, {:.0} per patch, {:.2} ms",
-            err(&v4096),
-            v4096.per_patch,
-            v4096.ms
-        );
-        for &tau in &taus {
-            let mut s = at("hisr").with(&hisr::TAU, tau).with(&hisr::TAU_MODE, mode);
-            if full {
-                s = s.with(&hisr::MAX_DEPTH, rsm.ilog2());
-            }
-            let h = measure(&gpu, &scene, &s, frames);
-            println!(
-                "{name}: hisr tau {tau}: error {:.5}, {:.0} per patch, {:.2} ms",
-                err(&h),
-                h.per_patch,
-                h.ms
-            );
-        }
-        assert!(dense.mask.iter().any(|&g| g));
     }
 }
 
@@ -157,12 +63,12 @@ fn hisr_error_with(
         }
         .with(&PATCH_KERNEL, kernel)
     };
-    let dense = measure(gpu, scene, &at("multires-gather").with(&VPLS, rsm * rsm), 1);
+    let dense = measure(gpu, scene, &at("multires-gather").with(&VPLS, rsm * rsm));
     let s = at("hisr")
         .with(&hisr::TAU, tau)
         .with(&hisr::TAU_MODE, mode)
         .with(&hisr::MAX_DEPTH, rsm.ilog2());
-    let h = measure(gpu, scene, &s, 1);
+    let h = measure(gpu, scene, &s);
     assert!(dense.mask.iter().any(|&g| g));
     let peak = dense
         .indirect
@@ -232,8 +138,9 @@ fn relative_tau_gives_like_errors_on_differently_lit_scenes() {
 
 /// The relative tau bounds the error for every light type: at tau 0.02 the
 /// box's spot, point light (six cube faces) and directional light each give
-/// an error below tau and above tau / 10 (measured: 0.49%, 0.61% and 0.35%;
-/// the spread between light types, 1.75x, is printed, not held).
+/// an error below tau (the guarantee), and each error is the one measured,
+/// 0.491%, 0.605% and 0.345%, within 10% (a regression value; the spread
+/// between light types, 1.75x, is printed, not held).
 #[test]
 fn relative_tau_bounds_the_error_for_every_light_type() {
     let gpu = gpu();
@@ -256,7 +163,18 @@ fn relative_tau_bounds_the_error_for_every_light_type() {
     let lo = errors.iter().map(|e| e.1).fold(f64::MAX, f64::min);
     let hi = errors.iter().map(|e| e.1).fold(0.0, f64::max);
     println!("spread (largest error over smallest): {:.2}", hi / lo);
-    assert!(lo > tau as f64 / 10.0 && hi < tau as f64, "{errors:?}");
+    assert!(hi < tau as f64, "{errors:?} above tau {tau}");
+    // Margin 10%: the errors were the same to every digit in three runs
+    // and with LP_NUM_THREADS=0; moving tau itself by 2%, which flips far
+    // more refinement decisions than another driver's rounding could,
+    // moves them by 1.2% to 2.5%.
+    let measured = [0.004908, 0.006051, 0.003455];
+    for ((name, e), m) in errors.iter().zip(measured) {
+        assert!(
+            (e / m - 1.0).abs() < 0.1,
+            "{name}: error {e:.6} where {m} was measured"
+        );
+    }
 }
 
 /// The second-order patch kernel (docs/algorithm.md section 2.6): HISR's
@@ -300,7 +218,7 @@ fn the_second_order_kernel_makes_whole_patches_err_less() {
         }
         .with(&VPLS, 64 * 64)
         .with(&PATCH_KERNEL, kernel);
-        measure(&gpu, &cornell_box(), &s, 1).indirect
+        measure(&gpu, &cornell_box(), &s).indirect
     };
     assert!(
         dense(PatchKernel::Centre) == dense(PatchKernel::SecondOrder),

@@ -7,6 +7,7 @@ mod common;
 
 use common::cli::{Isr, Ran};
 use common::temp_dir;
+use isr::bench::files;
 use std::path::Path;
 use std::time::Duration;
 
@@ -22,7 +23,8 @@ fn bench(dir: &Path, scene: &str) -> Isr {
 
 fn keys(dir: &Path) -> Vec<String> {
     let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("b/results.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(dir.join("b").join(files::RESULTS_JSON)).unwrap())
+            .unwrap();
     json["rows"]
         .as_array()
         .unwrap()
@@ -39,7 +41,7 @@ fn a_journal_torn_inside_a_character_is_read_and_the_line_skipped() {
     bench(&dir, "café.gltf").succeeds();
     let all = keys(&dir);
     assert!(all.len() >= 2 && all.iter().all(|k| k.starts_with("café|")));
-    let journal = dir.join("b/rows.jsonl");
+    let journal = dir.join("b").join(files::JOURNAL);
     let bytes = std::fs::read(&journal).unwrap();
     // Cut the last row inside its last `é` (0xC3 0xA9): invalid UTF-8.
     let cut = bytes.windows(2).rposition(|w| w == "é".as_bytes()).unwrap() + 1;
@@ -53,13 +55,14 @@ fn a_journal_torn_inside_a_character_is_read_and_the_line_skipped() {
     std::fs::write(&journal, &torn).unwrap();
     let ran = bench(&dir, "café.gltf").succeeds();
     assert!(
-        ran.stderr.contains("rows.jsonl line 2") && ran.stderr.contains("not valid UTF-8"),
+        ran.stderr.contains(&format!("{} line 2", files::JOURNAL))
+            && ran.stderr.contains("not valid UTF-8"),
         "the bad lines are not reported:\n{}",
         ran.stderr
     );
     let n = all.len() + 1;
     assert!(
-        ran.stderr.contains(&format!("rows.jsonl line {n}")),
+        ran.stderr.contains(&format!("{} line {n}", files::JOURNAL)),
         "the torn last line is not reported:\n{}",
         ran.stderr
     );
@@ -87,24 +90,25 @@ fn special_files_in_the_bench_folder_are_refused_by_name_before_work() {
     let dir = temp_dir("bench-special");
     let b = dir.join("b");
     std::fs::create_dir_all(&b).unwrap();
-    std::os::unix::fs::symlink("/dev/null", b.join("rows.jsonl")).unwrap();
-    refused(bench(&dir, "cornell").run(), "rows.jsonl");
-    std::fs::remove_file(b.join("rows.jsonl")).unwrap();
+    std::os::unix::fs::symlink("/dev/null", b.join(files::JOURNAL)).unwrap();
+    refused(bench(&dir, "cornell").run(), files::JOURNAL);
+    std::fs::remove_file(b.join(files::JOURNAL)).unwrap();
     // A FIFO: opening it would wait for a writer for ever.
-    let fifo =
-        std::ffi::CString::new(b.join("rows.jsonl").into_os_string().into_encoded_bytes()).unwrap();
+    let fifo = std::ffi::CString::new(b.join(files::JOURNAL).into_os_string().into_encoded_bytes())
+        .unwrap();
     // SAFETY: a valid C string; mkfifo only creates a file.
     assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0);
-    refused(bench(&dir, "cornell").run(), "rows.jsonl");
-    std::fs::remove_file(b.join("rows.jsonl")).unwrap();
+    refused(bench(&dir, "cornell").run(), files::JOURNAL);
+    std::fs::remove_file(b.join(files::JOURNAL)).unwrap();
     // Any other output: a chart, an image of the gallery.
-    std::os::unix::fs::symlink("/dev/null", b.join("results.csv")).unwrap();
-    refused(bench(&dir, "cornell").run(), "results.csv");
-    std::fs::remove_file(b.join("results.csv")).unwrap();
-    std::fs::create_dir_all(b.join("images/cornell/reference.png")).unwrap();
+    std::os::unix::fs::symlink("/dev/null", b.join(files::RESULTS_CSV)).unwrap();
+    refused(bench(&dir, "cornell").run(), files::RESULTS_CSV);
+    std::fs::remove_file(b.join(files::RESULTS_CSV)).unwrap();
+    let reference = files::images_dir(Path::new(""), "cornell").join(files::image("reference", ""));
+    std::fs::create_dir_all(b.join(&reference)).unwrap();
     let e = bench(&dir, "cornell").fails();
     assert!(
-        e.contains("images/cornell/reference.png") && e.contains("is a directory"),
+        e.contains(reference.to_str().unwrap()) && e.contains("is a directory"),
         "{e}"
     );
     // Nothing was measured or written.
@@ -112,7 +116,11 @@ fn special_files_in_the_bench_folder_are_refused_by_name_before_work() {
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names, ["images"], "written before the checks: {names:?}");
+    assert_eq!(
+        names,
+        [files::IMAGES],
+        "written before the checks: {names:?}"
+    );
 }
 
 /// The mean absolute difference of two images' bytes (RGBA8).
@@ -136,23 +144,28 @@ fn deleted_images_are_rendered_again_and_the_rows_kept() {
     let dir = temp_dir("bench-images");
     let b = dir.join("b");
     bench(&dir, "cornell").succeeds();
-    let rows = std::fs::read(b.join("rows.jsonl")).unwrap();
-    std::fs::copy(b.join("gallery.png"), dir.join("gallery-first.png")).unwrap();
-    let images = ["reference.png", "hisr.png", "hisr-error.png"];
-    std::fs::remove_dir_all(b.join("images")).unwrap();
+    let rows = std::fs::read(b.join(files::JOURNAL)).unwrap();
+    std::fs::copy(b.join(files::GALLERY), dir.join("gallery-first.png")).unwrap();
+    let images = [
+        files::image("reference", ""),
+        files::image("hisr", ""),
+        files::error_map("hisr", ""),
+    ];
+    std::fs::remove_dir_all(b.join(files::IMAGES)).unwrap();
     let ran = bench(&dir, "cornell").succeeds();
     for name in images {
-        let path = b.join("images/cornell").join(name);
+        let path = files::images_dir(&b, "cornell").join(name);
         image::open(&path).unwrap_or_else(|e| panic!("{}: {e}\n{}", path.display(), ran.stderr));
     }
     // The rows were not measured again: the journal is as it was.
-    assert_eq!(std::fs::read(b.join("rows.jsonl")).unwrap(), rows);
+    assert_eq!(std::fs::read(b.join(files::JOURNAL)).unwrap(), rows);
     // The gallery shows the images again (blank tiles differ by far more).
-    let d = mean_difference(&b.join("gallery.png"), &dir.join("gallery-first.png"));
+    let d = mean_difference(&b.join(files::GALLERY), &dir.join("gallery-first.png"));
     assert!(d < 0.5, "the gallery differs from the first run's by {d}");
     // One image missing: only it is missing, and it comes back.
-    std::fs::remove_file(b.join("images/cornell/hisr-error.png")).unwrap();
+    let error_map = files::images_dir(&b, "cornell").join(files::error_map("hisr", ""));
+    std::fs::remove_file(&error_map).unwrap();
     bench(&dir, "cornell").succeeds();
-    assert!(b.join("images/cornell/hisr-error.png").is_file());
-    assert_eq!(std::fs::read(b.join("rows.jsonl")).unwrap(), rows);
+    assert!(error_map.is_file());
+    assert_eq!(std::fs::read(b.join(files::JOURNAL)).unwrap(), rows);
 }

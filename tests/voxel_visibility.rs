@@ -1,5 +1,5 @@
 //! Indirect visibility's real-time approximation, `--visibility voxels`
-//! (issue 25, `passes::visibility_grid`): no false shadows in the empty
+//! (`voxel_grid`): no false shadows in the empty
 //! room, a disc's umbra on the GPU, convergence to the exact limit
 //! (`visibility.rs`) as the grid refines, the box against the truth, and
 //! validation for every gathering method with it on.

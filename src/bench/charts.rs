@@ -3,6 +3,7 @@
 //! binary (`dejavu` crate), registered with plotters' ab_glyph backend, so no
 //! system font is needed.
 
+use super::files::Chart;
 use super::rows::Row;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
@@ -39,9 +40,10 @@ pub fn method_color(method: &str) -> RGBColor {
 type Draw<'a> = dyn Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()> + 'a;
 type DrawPng<'a> = dyn Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<()> + 'a;
 
-/// Draws a chart to `stem.svg` and `stem.png` (the same function for both
-/// backends, written atomically).
-fn both(stem: &Path, size: (u32, u32), svg: &Draw, png: &DrawPng) -> Result<()> {
+/// Draws `chart` into `dir` as its SVG and its PNG (the same function for
+/// both backends, written atomically).
+fn both(dir: &Path, chart: Chart, size: (u32, u32), svg: &Draw, png: &DrawPng) -> Result<()> {
+    let stem = dir.join(chart.stem());
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
@@ -49,7 +51,7 @@ fn both(stem: &Path, size: (u32, u32), svg: &Draw, png: &DrawPng) -> Result<()> 
         root.present()
             .map_err(|e| anyhow!("drawing {}: {e}", stem.display()))?;
     }
-    crate::output::write_text(&stem.with_extension("svg"), &text)?;
+    crate::output::write_text(&dir.join(chart.svg()), &text)?;
     let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
@@ -61,7 +63,7 @@ fn both(stem: &Path, size: (u32, u32), svg: &Draw, png: &DrawPng) -> Result<()> 
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
-    crate::output::write_png(&stem.with_extension("png"), size.0, size.1, &rgba)
+    crate::output::write_png(&dir.join(chart.png()), size.0, size.1, &rgba)
 }
 
 /// Grid of (rows, columns) for `n` panels.
@@ -347,7 +349,8 @@ pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
     let title = "indirect time against error (log-log; lower left is better)";
     let y = |r: &Row| Some(r.rel_rmse_indirect);
     both(
-        &dir.join("speed_vs_error"),
+        dir,
+        Chart::SpeedVsError,
         size,
         &|a| {
             curves(
@@ -384,7 +387,8 @@ pub fn speed_vs_truth(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
     let y = |r: &Row| r.truth.rel_rmse_indirect;
     let label = "relative RMSE against the truth";
     both(
-        &dir.join("speed_vs_truth"),
+        dir,
+        Chart::SpeedVsTruth,
         size,
         &|a| curves(a, rows, scenes, title, label, &y, true),
         &|a| curves(a, rows, scenes, title, label, &y, true),
@@ -398,7 +402,8 @@ pub fn flicker(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     let title = "flicker against indirect time (log-log; lower left is better)";
     let y = |r: &Row| r.flicker;
     both(
-        &dir.join("flicker"),
+        dir,
+        Chart::Flicker,
         size,
         &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y, false),
         &|a| curves(a, rows, scenes, title, "flicker (indirect)", &y, false),
@@ -565,7 +570,8 @@ pub fn passes(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 460 * r as u32 + 40);
     both(
-        &dir.join("passes"),
+        dir,
+        Chart::Passes,
         size,
         &|a| stacked(a, rows, scenes),
         &|a| stacked(a, rows, scenes),

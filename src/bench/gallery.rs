@@ -1,6 +1,7 @@
 //! `gallery.png`, every method's image beside the reference's and its FLIP
 //! heat map, and the heat map itself (written with each bench image).
 
+use super::files;
 use super::rows::Row;
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
@@ -35,12 +36,12 @@ pub fn gallery(
     let mut cells: Vec<Vec<(String, Option<image::RgbaImage>)>> = vec![];
     let (mut cw, mut ch) = (64u32, 64u32);
     for s in scenes {
-        let images = dir.join("images").join(s);
+        let images = files::images_dir(dir, s);
         for (v, suffix) in visibilities {
             let reference = super::visibility::series_name("reference", v);
             let mut top = vec![(
                 format!("{s}: {reference}"),
-                load(&images.join(format!("reference{suffix}.png"))),
+                load(&images.join(files::image("reference", suffix))),
             )];
             let mut bottom = vec![("FLIP: black 0, white 1".to_string(), None)];
             for m in methods {
@@ -56,11 +57,11 @@ pub fn gallery(
                     }
                     None => format!("{name}: not run"),
                 };
-                top.push((label, load(&images.join(format!("{m}{suffix}.png")))));
+                top.push((label, load(&images.join(files::image(m, suffix)))));
                 let flip = row
                     .map(|r| format!("FLIP {:.3}", r.flip))
                     .unwrap_or_default();
-                bottom.push((flip, load(&images.join(format!("{m}{suffix}-error.png")))));
+                bottom.push((flip, load(&images.join(files::error_map(m, suffix)))));
             }
             for (_, img) in top.iter().chain(&bottom) {
                 if let Some(i) = img {
@@ -119,5 +120,5 @@ pub fn gallery(
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
-    crate::output::write_png(&dir.join("gallery.png"), w, h, &rgba)
+    crate::output::write_png(&dir.join(files::GALLERY), w, h, &rgba)
 }

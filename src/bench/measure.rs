@@ -141,7 +141,7 @@ fn reference(
     bar: &indicatif::ProgressBar,
 ) -> Result<Vec<RefFrame>> {
     let ref_row = work.ref_row;
-    let images = plan.out_dir.join("images").join(&spec.name);
+    let images = super::files::images_dir(&plan.out_dir, &spec.name);
     let with_truth = plan.truth_noise.is_some() && work.measures();
     let name = visibility::series_name("reference", &plan.visibility_label());
     let mut refs = Vec::with_capacity(plan.frames as usize);
@@ -234,7 +234,7 @@ fn points(
     journal: &Path,
     bar: &indicatif::ProgressBar,
 ) -> Result<()> {
-    let images = plan.out_dir.join("images").join(&spec.name);
+    let images = super::files::images_dir(&plan.out_dir, &spec.name);
     let shown = plan.visibility_label();
     // The allocator's total without any indirect method, to subtract; and
     // without the grid, which is part of what visibility costs a method.

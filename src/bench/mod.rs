@@ -5,6 +5,7 @@
 //! finish, so an interrupted run resumes where it stopped.
 
 pub mod charts;
+pub mod files;
 pub mod flip;
 pub mod gallery;
 mod measure;
@@ -362,7 +363,7 @@ pub struct Outcome {
 /// (`Plan::passes`): the reference's and, per method with a default point,
 /// that point's image and FLIP map.
 fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
-    let images = plan.out_dir.join("images").join(&spec.name);
+    let images = files::images_dir(&plan.out_dir, &spec.name);
     let mut files = vec![images.join(reference_image(plan))];
     for c in plan.configs().iter().filter(|c| c.is_default(&plan.base)) {
         files.extend(point_images(plan, c).map(|n| images.join(n)));
@@ -373,20 +374,20 @@ fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
 /// The gallery image of pass `plan`'s reference: `reference.png`, or with
 /// the grid `reference-voxels.png`.
 fn reference_image(plan: &Plan) -> String {
-    format!("reference{}.png", plan.image_suffix())
+    files::image("reference", plan.image_suffix())
 }
 
 /// The gallery images of point `c` of pass `plan`, its image and its FLIP
 /// map: `hisr.png` and `hisr-error.png`, or `hisr-voxels.png` ...
 fn point_images(plan: &Plan, c: &Config) -> [String; 2] {
     let (m, v) = (c.method.name(), plan.image_suffix());
-    [format!("{m}{v}.png"), format!("{m}{v}-error.png")]
+    [files::image(m, v), files::error_map(m, v)]
 }
 
 /// Whether the gallery images of point `c` of `spec` (or, without one, the
 /// reference's) are all there.
 fn images_present(plan: &Plan, spec: &SceneSpec, c: Option<&Config>) -> bool {
-    let images = plan.out_dir.join("images").join(&spec.name);
+    let images = files::images_dir(&plan.out_dir, &spec.name);
     let names = match c {
         None => vec![reference_image(plan)],
         Some(c) => point_images(plan, c).to_vec(),
@@ -406,8 +407,8 @@ fn check_outputs(plan: &Plan) -> Result<()> {
         "remove it, or choose another --out-dir than {}",
         dir.display()
     );
-    let mut files: Vec<PathBuf> = std::iter::once("rows.jsonl")
-        .chain(report::FILES.iter().copied())
+    let mut files: Vec<PathBuf> = std::iter::once(files::JOURNAL.to_string())
+        .chain(files::written())
         .map(|n| dir.join(n))
         .collect();
     for s in &plan.scenes {
@@ -427,7 +428,7 @@ fn check_outputs(plan: &Plan) -> Result<()> {
 pub fn run(plan: &Plan) -> Result<Outcome> {
     let dir = &plan.out_dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let journal = dir.join("rows.jsonl");
+    let journal = dir.join(files::JOURNAL);
     check_outputs(plan)?;
     let found = rows::read_journal(&journal)?;
     for w in found.warnings(&journal) {
@@ -489,10 +490,7 @@ pub fn cli(args: &BenchArgs) -> Result<()> {
     let plan = args.plan()?;
     let outcome = run(&plan)?;
     println!("{}", ratios::ratios_text(&ratios::ratios(&outcome.rows)));
-    println!(
-        "wrote results.json, results.csv, charts, gallery.png and report.md to {}",
-        plan.out_dir.display()
-    );
+    println!("wrote {} to {}", files::summary(), plan.out_dir.display());
     Ok(())
 }
 

@@ -2,6 +2,7 @@
 //! charts, the gallery, and `report.md` with its tables and the ratios
 //! (`ratios`), computed from the same rows.
 
+use super::files::{self, Chart};
 use super::ratios::{flicker_64_over_4096, fmt_value, ratios, regular, with_visibility, Ratio};
 use super::rows;
 use super::visibility::visibilities;
@@ -77,9 +78,16 @@ against the dense reference with it, and the one truth of each frame).{}\n\n",
         visibilities(&o.rows).join(", "),
         if plan.quick { " Quick run (smoke test)." } else { "" }
     );
-    md += "![speed against error](speed_vs_error.svg)\n\n\
-![speed against error from the truth](speed_vs_truth.svg)\n\n![flicker](flicker.svg)\n\n\
-![per-pass times](passes.svg)\n\n![gallery](gallery.png)\n\n";
+    for chart in Chart::ALL {
+        let alt = match chart {
+            Chart::SpeedVsError => "speed against error",
+            Chart::SpeedVsTruth => "speed against error from the truth",
+            Chart::Flicker => "flicker",
+            Chart::Passes => "per-pass times",
+        };
+        md += &format!("![{alt}]({})\n\n", chart.svg());
+    }
+    md += &format!("![gallery]({})\n\n", files::GALLERY);
     md += &model_errors(plan, o);
     md += &flicker_table(plan, o);
     md += &super::visibility::report_table(plan, &o.rows);
@@ -192,24 +200,8 @@ reference. The truth's noise adds to every error against it in quadrature.\n\n")
     md
 }
 
-/// The files [`write_all`] writes into the run's folder (checked before a
-/// run begins, with `rows.jsonl` and the gallery's images).
-pub const FILES: &[&str] = &[
-    "results.json",
-    "results.csv",
-    "speed_vs_error.svg",
-    "speed_vs_error.png",
-    "speed_vs_truth.svg",
-    "speed_vs_truth.png",
-    "flicker.svg",
-    "flicker.png",
-    "passes.svg",
-    "passes.png",
-    "gallery.png",
-    "report.md",
-];
-
-/// Writes every output of a run into its folder.
+/// Writes every output of a run into its folder (`files::written`, in its
+/// order).
 pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
     let dir = &plan.out_dir;
     let b = &plan.base;
@@ -230,10 +222,10 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         "rows": o.rows,
     });
     crate::output::write_text(
-        &dir.join("results.json"),
+        &dir.join(files::RESULTS_JSON),
         &serde_json::to_string_pretty(&json)?,
     )?;
-    crate::output::write_text(&dir.join("results.csv"), &rows::to_csv(&o.rows))?;
+    crate::output::write_text(&dir.join(files::RESULTS_CSV), &rows::to_csv(&o.rows))?;
     super::charts::speed_vs_error(dir, &o.rows, &scenes)?;
     super::charts::speed_vs_truth(dir, &o.rows, &scenes)?;
     super::charts::flicker(dir, &o.rows, &scenes)?;
@@ -245,6 +237,6 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         .map(|p| (p.visibility_label(), p.image_suffix()))
         .collect();
     super::gallery::gallery(dir, &o.rows, &scenes, &methods, &passes)?;
-    crate::output::write_text(&dir.join("report.md"), &markdown(plan, o, &ratios))?;
+    crate::output::write_text(&dir.join(files::REPORT), &markdown(plan, o, &ratios))?;
     Ok(())
 }

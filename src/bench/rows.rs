@@ -332,7 +332,7 @@ mod tests {
     fn the_journal_keeps_finished_rows_and_skips_a_torn_line() {
         let dir = std::env::temp_dir().join(format!("isr-journal-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("rows.jsonl");
+        let path = dir.join(crate::bench::files::JOURNAL);
         let _ = std::fs::remove_file(&path);
         assert!(read_journal(&path).unwrap().rows.is_empty());
         append(&path, &row("a")).unwrap();
@@ -367,7 +367,8 @@ mod tests {
         assert!(journal.skipped[1].1.starts_with("not valid UTF-8"));
         assert!(journal.skipped[3].1.starts_with("not a row"));
         let w = journal.warnings(&path);
-        assert!(w[1].contains("rows.jsonl line 5 is skipped"), "{w:?}");
+        let skipped = format!("{} line 5 is skipped", crate::bench::files::JOURNAL);
+        assert!(w[1].contains(&skipped), "{w:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

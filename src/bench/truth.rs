@@ -253,6 +253,17 @@ pub struct Truth {
     pub noise: f64,
 }
 
+impl Truth {
+    /// The relative RMSE of indirect radiance `x` against this truth over
+    /// its mask, with the truth's own noise taken out in quadrature
+    /// (independent errors add so): the error of the model, not of the
+    /// truth's sampling.
+    pub fn model_error(&self, x: &[[f32; 4]]) -> f64 {
+        let e = super::metrics::relative_rmse(x, &self.image.indirect, &self.mask.mask);
+        (e * e - self.noise * self.noise).max(0.0).sqrt()
+    }
+}
+
 /// Two independent estimates of the indirect image (odd and even seeds),
 /// each a sample-weighted mean; their difference measures the noise of
 /// their mean without knowing the answer.

@@ -24,11 +24,7 @@ pub(super) fn model_floor(
     out: &Readback,
     bar: &indicatif::ProgressBar,
 ) -> Result<Vec<[f32; 4]>> {
-    let path = plan
-        .out_dir
-        .join("truth")
-        .join(&spec.name)
-        .join(format!("exact-{k}.exr"));
+    let path = super::files::truth_dir(&plan.out_dir, &spec.name).join(format!("exact-{k}.exr"));
     let time = frame_time(spec, k);
     if let Some(cached) = cached_exact(&path, out, time, plan.base.rsm_resolution) {
         return Ok(cached);
@@ -71,11 +67,7 @@ pub(super) fn frame_truth(
         target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
         seed: k as u64 + 1,
     };
-    let path = plan
-        .out_dir
-        .join("truth")
-        .join(&spec.name)
-        .join(format!("frame-{k}.exr"));
+    let path = super::files::truth_dir(&plan.out_dir, &spec.name).join(format!("frame-{k}.exr"));
     let shadows = truth::ShadowMaps::new(
         r.light_views(),
         r.render_origin(),

@@ -185,7 +185,7 @@ pub fn run() -> Result<()> {
         Command::Bench(args) => {
             interrupt::set_note(format!(
                 "the rows finished are kept in {}; the same command resumes from them",
-                args.out_dir.join("rows.jsonl").display()
+                args.out_dir.join(crate::bench::files::JOURNAL).display()
             ));
             crate::bench::cli(&args)
         }

@@ -31,11 +31,10 @@ use isr::vk::{Gpu, GpuOptions, Validation};
 pub use isr::bench::metrics::{geometry_mask, relative_rmse};
 
 /// Relative RMSE of indirect radiance `x` against the path-traced truth `t`
-/// over its mask, with the truth's own noise taken out in quadrature: the
-/// error of the model, not of the truth's sampling.
+/// over its mask, with the truth's own noise taken out in quadrature
+/// (`Truth::model_error`).
 pub fn model_error(x: &[[f32; 4]], t: &isr::bench::truth::Truth) -> f64 {
-    let e = relative_rmse(x, &t.image.indirect, &t.mask.mask);
-    (e * e - t.noise * t.noise).max(0.0).sqrt()
+    t.model_error(x)
 }
 
 // Devices.
