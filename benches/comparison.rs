@@ -83,7 +83,7 @@ fn main() -> anyhow::Result<()> {
     std::fs::write(
         dir.join("../comparison.json"),
         serde_json::to_string_pretty(
-            &json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": isr::methods::vpls::VPLS.get(&base),
+            &json!({"device": gpu.info.name, "width": 256, "height": 256, "rsm": 256, "vpls": isr::regular_vpls::VPLS.get(&base),
             "reference_ms": reference_ms, "runs": rows}),
         )?,
     )?;

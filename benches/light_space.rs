@@ -10,8 +10,8 @@
 //! shared CPU the least disturbed frame is the steadiest measure, and rounds
 //! spread a slow spell over every row. Writes `target/bench/light_space.json`.
 
-use isr::methods::vpls::VPLS;
 use isr::methods::{hisr, multires_gather};
+use isr::regular_vpls::VPLS;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::RenderSettings;

@@ -30,7 +30,7 @@ fn main() -> anyhow::Result<()> {
             method,
             ..Default::default()
         }
-        .with(&isr::methods::vpls::VPLS, 64);
+        .with(&isr::regular_vpls::VPLS, 64);
         let started = std::time::Instant::now();
         let bar = isr::progress::bar(frames as u64, "frames");
         bar.set_message(method.name());

@@ -18,8 +18,9 @@
 use anyhow::{bail, Context as _, Result};
 use isr::bench::metrics::{geometry_mask, relative_rmse};
 use isr::bench::scenes;
-use isr::methods::{hisr, vpls::VPLS};
+use isr::methods::hisr;
 use isr::passes::rsm_tree::{PatchKernel, PATCH_KERNEL};
+use isr::regular_vpls::VPLS;
 use isr::renderer::Renderer;
 use isr::scene::Scene;
 use isr::settings::{Method, RenderSettings};

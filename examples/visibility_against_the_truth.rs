@@ -32,17 +32,17 @@
 use anyhow::{bail, Result};
 use glam::DVec3;
 use isr::bench::truth::{trace, ShadowMaps, Truth};
+use isr::exact_visibility::gather;
 use isr::methods::hisr::{SHARED_REFINE, SHARED_VISIBILITY, TAU};
-use isr::visibility::{Visibility, VISIBILITY};
-use isr::voxel_grid::{GRID, SUBCELLS};
 use isr::pathtrace::Occluders;
 use isr::readback::Readback;
 use isr::renderer::Renderer;
 use isr::scene::Scene;
 use isr::settings::{Method, RenderSettings};
 use isr::view::LightView;
-use isr::exact_visibility::gather;
+use isr::visibility::{Visibility, VISIBILITY};
 use isr::vk::{Gpu, GpuOptions};
+use isr::voxel_grid::{GRID, SUBCELLS};
 use std::path::PathBuf;
 
 /// The truth's noise target: the measured errors have it taken out, so it

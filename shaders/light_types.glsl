@@ -1,7 +1,7 @@
 // What differs between the light types (docs/algorithm.md section 2.4): spot,
 // one cube face of a point light, directional. Every pass that depends on the
-// type calls these small functions, so a pass's own code (and the HISR
-// traversal loop) stays the same for all types. Needs frame.glsl (`u`, `run`).
+// type calls these small functions, so a pass's own code stays the same for
+// all types. Needs frame.glsl (`u`, `run`).
 #ifndef LIGHT_TYPES_GLSL
 #define LIGHT_TYPES_GLSL
 #include "lighting.glsl"
@@ -107,46 +107,6 @@ float shadow_reference(float z, float slope) {
 float validity_reach(vec3 p) {
     if (light_is_directional()) return u.rsm_half_extent;
     return distance(p, u.light_position);
-}
-
-// HISR (multires/gather.frag, docs/algorithm.md sections 2.4 and 4.3): subdivide patch j
-// (mean position pj, node xy at depth d: 2^d x 2^d patches across the RSM)
-// iff |V_ij|^2 <= 4^k * hisr_bound(...), k its levels above the finest.
-// t_finest is T of multires/gather.frag's derivation (run.hisr_threshold), which is
-// dw_talk (1 - tau) / (pi tau) with the talk's texel solid angle
-// dw_talk = 2 pi / (3 R^2).
-//
-// Spot (the talk): C_ij <= I dw / (pi |V_ij|^2 + dw |V_j|^2) > tau I / |V_j|^2
-//   iff |V_ij|^2 < dw (1 - tau) / (pi tau) |V_j|^2 = T |V_j|^2 with dw = dw_talk.
-// Cube face: the same inequality holds with dw the largest texel solid angle
-//   in the patch. On a 90 degree face dw = (2/R)^2 cos^3 alpha, largest at the
-//   patch's point nearest the face centre (alpha smallest); so the bound is
-//   T |V_j|^2 dw_max / dw_talk = T |V_j|^2 * 6 cos^3 alpha_min / pi: exact for
-//   every texel rather than one average solid angle (texels shrink ~5x toward
-//   the face's corners, where this splits less).
-// Orthographic: Phi_j <= E m a and A_j >= m a for the patch's m <= 4^k
-//   non-empty texels of area a = (2h/R)^2 (no light distance), and
-//   Phi / (pi d^2 + A) grows with m: C_ij <= E 4^k a / (pi |V_ij|^2 + 4^k a),
-//   above tau E iff |V_ij|^2 < 4^k a (1 - tau) / (pi tau) = 4^k T a / dw_talk
-//   = 4^k T 6 h^2 / pi.
-float hisr_bound(vec3 pj, ivec3 node, float t_finest) {
-    if (light_is_directional()) {
-        float h = u.rsm_half_extent;
-        return t_finest * 6.0 * h * h / PI;
-    }
-    vec3 vj = pj - u.light_position;
-    float bound = t_finest * dot(vj, vj);
-    if (u.light_kind == LIGHT_POINT) {
-        // The patch's square on the face's image plane [-1, 1]^2, and its
-        // point nearest the centre.
-        float side = float(1 << node.z);
-        vec2 lo = vec2(node.xy) / side * 2.0 - 1.0;
-        vec2 hi = lo + 2.0 / side;
-        vec2 nearest = clamp(vec2(0.0), lo, hi);
-        float cos_alpha = inversesqrt(1.0 + dot(nearest, nearest));
-        bound *= 6.0 * cos_alpha * cos_alpha * cos_alpha / PI;
-    }
-    return bound;
 }
 
 #endif

@@ -40,10 +40,12 @@ const int LIGHT_SPOT = 0;         // perspective, the square around the outer co
 const int LIGHT_POINT = 1;        // one 90 degree cube face; six make the point light
 const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 
-// What is fixed for a run: sizes, thresholds, levels (std140 uniform block,
-// set 0 binding 1, written once). Each group is filled by the module that
-// owns its parameters (src/gpu_types.rs names it), from the one function
-// that derives each value.
+// What is fixed for a run and shared by the passes of every method: sizes,
+// thresholds, levels (std140 uniform block, set 0 binding 1, written once).
+// Each group is filled by the module that owns its parameters
+// (src/gpu_types.rs names it), from the one function that derives each
+// value. A method's own parameters reach its shaders as specialization
+// constants, declared in its shader folder.
 struct RunUniforms {
     // Shadows of the direct light.
     float shadow_normal_offset;   // RSM texels at the receiver (0 by default)
@@ -61,31 +63,16 @@ struct RunUniforms {
     float normal_chord;           // normal threshold as the chord |n_max - n_min| of
                                   // the normals' component box, 2 sin(angle / 2)
     int hierarchy_flags;          // HIERARCHY_*
-    // The regular VPLs: level vpl_level of the RSM quadtree, vpl_side x
-    // vpl_side of them.
-    int vpl_level;
-    int vpl_side;
     // Patch validity in the RSM quadtree (docs/algorithm.md section 4).
     float validity_depth;         // relative to the distance to the light
     float validity_normal_cos;    // cosine of the angle threshold
-    // Basic ISR.
-    int isr_base_level;           // RSM quadtree level (mip) of the base
-    // HISR (docs/algorithm.md section 4.3).
-    float hisr_threshold;         // T at the finest level, computed once on the host
-                                  // (multires/gather.frag derives the test)
-    int hisr_start_depth;         // traversal starts from 2^s x 2^s patches
-    int hisr_max_depth;           // and subdivides down to 2^d x 2^d
-    // Restricted splats.
-    float splat_threshold;        // irradiance bound, W/m^2
-    // HISR's tau and what it is relative to (docs/algorithm.md section 4.3;
-    // hisr_reach in hisr/hisr.glsl).
-    float hisr_tau;               // --tau
-    int hisr_tau_mode;            // HISR_TAU_*
     int patch_kernel;             // PATCH_KERNEL_*: how a merged light patch is evaluated (vpl.glsl)
     // The voxel grid (docs/algorithm.md section 5.6; src/voxel_grid).
     int grid_side;                // N: finest cells per side (a power of 2)
     int grid_levels;              // levels 0..grid_levels-1, side N >> k (at least 4)
     int pad0;
+    int pad1;
+    int pad2;
 };
 
 // RunUniforms::patch_kernel (docs/algorithm.md section 2.6): a patch of
@@ -93,10 +80,6 @@ struct RunUniforms {
 // with the second-order term of its texels' spread added.
 const int PATCH_KERNEL_CENTRE = 0;
 const int PATCH_KERNEL_SECOND_ORDER = 1;
-
-// RunUniforms::hisr_tau_mode: what HISR's tau bounds (docs/algorithm.md 4.3).
-const int HISR_TAU_RELATIVE = 0;  // each evaluated patch's solid angle seen from the receiver
-const int HISR_TAU_ABSOLUTE = 1;  // the talk's: its bound over the light's peak intensity
 
 // Where one mesh instance is this frame (std430, set 0 binding 2, one per
 // `Scene::instances` entry, one buffer per frame in flight).
@@ -107,13 +90,14 @@ struct InstanceTransform {
 
 const float PI = 3.14159265358979323846;
 
-// One light patch chosen by Basic ISR (a node of the RSM quadtree).
+// One light patch: a node of the RSM quadtree, in the lists a light-space
+// source writes for the gather (multires::LightSource).
 struct LightPatch {
     vec4 position_area;  // xyz: flux-weighted mean position (m; rsm_tree.comp); w: area A (m^2)
-    vec4 normal;         // xyz: unit mean normal; w: patch_level (the lists: ISR's and
-                         // the regular VPLs') or PATCH_* (HISR's packed tree)
+    vec4 normal;         // xyz: unit mean normal; w: patch_level in a list, or
+                         // PATCH_* in a packed tree
     vec4 flux;           // rgb: summed flux Phi (W); a: summed solid angle (sr), or
-                         // the squared reach (hisr_reach, HISR's packed tree)
+                         // what a source keeps there (a packed tree: its squared reach)
 };
 
 // RSM quadtree normal.w: what a patch is.
@@ -126,54 +110,7 @@ const float PATCH_INVALID = -1.0; // spans a depth or normal discontinuity (ISR 
 // (state PATCH_INVALID), whose texels lie on no one disc.
 int patch_level(int k, float state) { return state == PATCH_INVALID ? -k : k; }
 
-// HISR splits an invalid patch while its bound could exceed tau times this
-// (multires/gather.frag, docs/algorithm.md section 4.3).
-const float HISR_INVALID_TAU_SCALE = 0.01;
-
-// HISR's per-tile cuts (docs/algorithm.md section 4.4) come in
-// HISR_CUT_LEVELS chained levels: level c has tiles of 2^(K + c) pixels a
-// side; the coarsest is cut from the start depth, each finer one from its
-// parent tile's "traverse" entries. Layout of the buffer (hisr/cut.comp
-// writes it, multires/gather.frag reads it): this header, then per level a count per
-// tile, then per level `capacity` entries per tile (hisr/hisr.glsl: packed indices
-// for evaluate entries, cut_entry for traverse entries):
-// a tile's "evaluate" entries from the front of its range, its "traverse"
-// entries from the back. A count holds the evaluate entries in bits 0-15 and
-// the traverse entries in bits 16-31, or is HISR_CUT_OVERFLOW. Offsets count
-// uints after the header. With the voxel grid and shared tile visibility,
-// then per finest tile one word per slot of the three levels (coarsest
-// level first; evaluate entries, and the finest level's traverse entries):
-// the entry's visibility from the tile's four corner pixels, packUnorm4x8 (hisr/visibility.comp writes it, multires/gather.frag
-// interpolates it); then per finest tile a bit per slot, set where every
-// receiver marches the entry itself (the corners disagree or none has
-// geometry: hisr/visibility.comp), so the gather finds the entries of each
-// kind a word of 32 slots at a time; then (with refinement) the tile's
-// further points, their visibilities and march bits (HisrCutHeader.points).
-const int HISR_CUT_LEVELS = 3;
-struct HisrCutHeader {
-    uvec4 tiles[HISR_CUT_LEVELS];  // per level: x, y: tiles per row and column; z: tile
-                                   // level K + c; w: offset of its counts
-    uvec4 entries;                 // y, z, w: offset of levels 0, 1, 2's entries; x: of the
-                                   // finest tiles' boxes (8 floats each, hisr/cut.comp)
-    uvec4 capacity;                // x, y, z: entries per tile of levels 0, 1, 2
-    uvec4 visibility;              // x: offset of the entries' corner visibilities
-                                   // (hisr/visibility.comp), 0 without them; y: their slots
-                                   // per finest tile (the capacities' sum); z: offset of
-                                   // the march bits; w: their words per finest tile
-    uvec4 points;                  // x: offset of the tile points' pixels (4 words per
-                                   // finest tile, (y << 16) | x, ~0u past the last);
-                                   // y: of their visibilities, as the corners' (0 without);
-                                   // z: of their receivers' march bits, as the corners'
-                                   // (hisr/tile_points.glsl)
-};
-
-// A tile whose cut did not fit: its fragments traverse from the roots.
-const uint HISR_CUT_OVERFLOW = 4294967295u;
-
 // RunUniforms::hierarchy_flags bits.
-const int HIERARCHY_POINT_VPLS = 1;    // one texel per VPL patch, flux and area scaled up
-// (Bit 2 is free: nearest or interpolated upsampling is a specialisation
-// constant of multires/upsample.comp.)
 const int HIERARCHY_STENCIL_OFF = 4;   // gather every texel, mask afterwards
 
 // Geometry-mip flag bits (image geo_flags).

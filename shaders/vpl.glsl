@@ -27,7 +27,7 @@ layout(constant_id = 20) const bool VOXEL_VISIBILITY = false;
 // where the rest is not 0, so that a list's fragments march together
 // (one march's loop at a time: lavapipe's loop limit, voxel_grid/march.glsl).
 // patch_unshadowed is E without V_ij, for a caller that finds V_ij itself
-// (HISR's tile-shared visibility, multires/gather.frag).
+// (HISR's tile-shared visibility, hisr/gather.frag).
 vec3 patch_unshadowed(vec3 xi, vec3 ni, vec3 xj, vec3 nj, vec3 phi, float a, int level) {
     vec3 v = xj - xi;
     float d2 = dot(v, v);

@@ -70,7 +70,8 @@ pub fn indirect_png(r: &Readback, exposure: f32) -> Vec<u8> {
 /// Light patches evaluated per eye-space patch: how many, over all patches.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct LightPatchStats {
-    /// Patches Basic ISR chose this frame (method `isr`).
+    /// Light patches the method's source chose this frame, for a source
+    /// that chooses them anew every frame (Basic ISR's).
     pub chosen: Option<u32>,
     pub per_patch_min: u32,
     pub per_patch_mean: f64,
@@ -82,7 +83,7 @@ pub struct LightPatchStats {
 impl std::fmt::Display for LightPatchStats {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if let Some(c) = self.chosen {
-            write!(f, "light patches chosen by ISR: {c}; ")?;
+            write!(f, "light patches chosen this frame: {c}; ")?;
         }
         write!(
             f,

@@ -49,8 +49,10 @@ pub const LIGHT_SPOT: i32 = 0;
 pub const LIGHT_POINT: i32 = 1;
 pub const LIGHT_DIRECTIONAL: i32 = 2;
 
-/// `RunUniforms` (std140): what is fixed for a run. Each group is filled by
-/// the module that owns its parameters (`shaders/shared.glsl` names them).
+/// `RunUniforms` (std140): what is fixed for a run and shared by the passes
+/// of every method. Each group is filled by the module that owns its
+/// parameters (`shaders/shared.glsl` names them); a method's own parameters
+/// reach its shaders as specialization constants instead.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RunUniforms {
@@ -68,23 +70,9 @@ pub struct RunUniforms {
     pub normal_chord: f32,
     /// `HIERARCHY_*` bits.
     pub hierarchy_flags: i32,
-    /// The regular VPLs (`methods::vpls::RegularVpls`).
-    pub vpl_level: i32,
-    pub vpl_side: i32,
     /// Patch validity (`passes::rsm_tree::write_uniforms`).
     pub validity_depth: f32,
     pub validity_normal_cos: f32,
-    /// Basic ISR (`methods::isr`).
-    pub isr_base_level: i32,
-    /// HISR (`methods::hisr`).
-    pub hisr_threshold: f32,
-    pub hisr_start_depth: i32,
-    pub hisr_max_depth: i32,
-    /// Restricted splats (`methods::rsm_splat`).
-    pub splat_threshold: f32,
-    /// HISR's tau and `HISR_TAU_*` (`methods::hisr`).
-    pub hisr_tau: f32,
-    pub hisr_tau_mode: i32,
     /// How a merged light patch is evaluated (`passes::rsm_tree::PATCH_KERNEL`):
     /// `PATCH_KERNEL_*`.
     pub patch_kernel: i32,
@@ -93,6 +81,8 @@ pub struct RunUniforms {
     pub grid_side: i32,
     pub grid_levels: i32,
     pub pad0: i32,
+    pub pad1: i32,
+    pub pad2: i32,
 }
 
 /// `RunUniforms::patch_kernel` values, as in `shaders/shared.glsl`.
@@ -119,10 +109,6 @@ pub struct GridLevelPush {
     pub level: i32,
 }
 
-/// `RunUniforms::hisr_tau_mode` values, as in `shaders/shared.glsl`.
-pub const HISR_TAU_RELATIVE: i32 = 0;
-pub const HISR_TAU_ABSOLUTE: i32 = 1;
-
 /// `InstanceTransform` (std430): where one mesh instance is this frame.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -144,54 +130,26 @@ impl InstanceTransform {
     }
 }
 
-/// `LightPatch` (std430): one patch chosen by Basic ISR.
+/// `LightPatch` (std430): one light patch, a node of the RSM quadtree, as the
+/// lists a light-space source writes for the gather hold it
+/// (`multires::LightSource`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LightPatch {
     /// xyz: mean position; w: area.
     pub position_area: [f32; 4],
-    /// xyz: mean normal; w: in the lists (ISR's, the regular VPLs') the
-    /// quadtree level (RSM mip), negated where the patch spans a
-    /// discontinuity (`patch_level` in `shaders/shared.glsl`); in HISR's
-    /// packed tree `PATCH_*`.
+    /// xyz: mean normal; w: in a list, the quadtree level (RSM mip), negated
+    /// where the patch spans a discontinuity (`patch_level` in
+    /// `shaders/shared.glsl`); in a packed tree `PATCH_*`.
     pub normal: [f32; 4],
-    /// rgb: flux; a: solid angle (in HISR's packed tree: the squared reach).
+    /// rgb: flux; a: solid angle, or what the source keeps there (a packed
+    /// tree: its squared reach).
     pub flux: [f32; 4],
 }
 
-/// Header of the chosen-patch buffer before the `LightPatch` array.
-pub const CHOSEN_PATCHES_HEADER: usize = 16;
-
-/// Chained levels of HISR's tile cuts, as in `shaders/shared.glsl`.
-pub const HISR_CUT_LEVELS: usize = 3;
-
-/// `HisrCutHeader` (std430): the head of HISR's per-tile cut buffer
-/// (`shaders/hisr/cut.comp`): per level, tiles per row and column, tile level
-/// and the offset of its counts; each level's entry offset (`entries[1 + c]`)
-/// and its entries per tile (`capacity[c]`); the finest tiles' boxes at
-/// `entries[0]` (8 floats a tile); with shared tile visibility, the
-/// entries' corner visibilities at `visibility[0]`, `visibility[1]` words per
-/// finest tile, and their march bits at `visibility[2]`, `visibility[3]`
-/// words per finest tile, and the further tile points' pixels at
-/// `points[0]` (4 words per finest tile), their visibilities at `points[1]`
-/// and march bits at `points[2]`, laid out as the corners'
-/// (`shaders/hisr/visibility.comp`); offsets in `u32`s after the header.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct HisrCutHeader {
-    pub tiles: [[u32; 4]; HISR_CUT_LEVELS],
-    pub entries: [u32; 4],
-    pub capacity: [u32; 4],
-    pub visibility: [u32; 4],
-    pub points: [u32; 4],
-}
-
-/// A tile count that means "the cut did not fit", as in `shaders/shared.glsl`.
-pub const HISR_CUT_OVERFLOW: u32 = u32::MAX;
-
-/// HISR splits an invalid patch while its bound could exceed tau times this,
-/// as in `shaders/shared.glsl`.
-pub const HISR_INVALID_TAU_SCALE: f32 = 0.01;
+/// Header of a light-patch buffer (its count, padded) before the
+/// `LightPatch` array.
+pub const LIGHT_PATCHES_HEADER: usize = 16;
 
 /// RSM quadtree `normal.w` values, as in `shaders/shared.glsl`.
 pub const PATCH_EMPTY: f32 = 0.0;
@@ -199,7 +157,6 @@ pub const PATCH_VALID: f32 = 1.0;
 pub const PATCH_INVALID: f32 = -1.0;
 
 /// `RunUniforms::hierarchy_flags` bits, as in `shaders/shared.glsl`.
-pub const HIERARCHY_POINT_VPLS: i32 = 1;
 pub const HIERARCHY_STENCIL_OFF: i32 = 4;
 
 /// Geometry-mip flag bits, as in `shaders/shared.glsl`.

@@ -3,7 +3,7 @@
 //! decoded by name, so adding or reordering a region cannot shift the others.
 
 use crate::frame::Targets;
-use crate::gpu_types::{LightPatch, CHOSEN_PATCHES_HEADER, GEO_HAS_GEOMETRY, GEO_SMOOTH};
+use crate::gpu_types::{LightPatch, GEO_HAS_GEOMETRY, GEO_SMOOTH, LIGHT_PATCHES_HEADER};
 use crate::multires::MultiresBuffer;
 use crate::vk::barrier::{self, Use};
 use crate::vk::resources::texel_bytes;
@@ -394,15 +394,15 @@ pub fn read_multires(gpu: &Gpu, m: &MultiresBuffer, t: &Targets) -> Result<Multi
     })
 }
 
-/// Basic ISR's chosen light patches from `buffer` (header, then the list).
-pub fn read_chosen_patches(gpu: &Gpu, buffer: &Buffer) -> Result<Vec<LightPatch>> {
+/// The light patches in `buffer` (header, then the list: `multires::LightPatches`).
+pub fn read_light_patches(gpu: &Gpu, buffer: &Buffer) -> Result<Vec<LightPatch>> {
     let bytes = read_buffer(gpu, buffer)?;
     let size = std::mem::size_of::<LightPatch>();
     let count = u32::from_le_bytes(bytes[..4].try_into()?) as usize;
     // Clamped to the capacity: before any frame the count is not yet written.
-    let capacity = (bytes.len() - CHOSEN_PATCHES_HEADER) / size;
-    let end = CHOSEN_PATCHES_HEADER + count.min(capacity) * size;
+    let capacity = (bytes.len() - LIGHT_PATCHES_HEADER) / size;
+    let end = LIGHT_PATCHES_HEADER + count.min(capacity) * size;
     Ok(bytemuck::pod_collect_to_vec(
-        &bytes[CHOSEN_PATCHES_HEADER..end],
+        &bytes[LIGHT_PATCHES_HEADER..end],
     ))
 }

@@ -41,7 +41,7 @@ pub struct TimingReport {
     /// Multiresolution patches per level (level 0 first), last frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub patches_per_level: Option<Vec<u32>>,
-    /// Light patches evaluated per eye-space patch (and chosen by ISR).
+    /// Light patches evaluated per eye-space patch (and, for a source that chooses them per frame, how many it chose).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub light_patches: Option<crate::debug_view::LightPatchStats>,
     /// Animation time of the frame (sequences).

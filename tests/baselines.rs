@@ -3,8 +3,9 @@
 mod common;
 
 use common::*;
-use isr::methods::{reference, rsm_splat, vpls::VPLS};
+use isr::methods::{reference, rsm_splat};
 use isr::multires::{DEPTH_THRESHOLD, NORMAL_THRESHOLD};
+use isr::regular_vpls::VPLS;
 use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};

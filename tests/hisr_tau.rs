@@ -7,8 +7,9 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::methods::{hisr, vpls::VPLS};
+use isr::methods::hisr;
 use isr::passes::rsm_tree::{PatchKernel, PATCH_KERNEL};
+use isr::regular_vpls::VPLS;
 use isr::renderer::Renderer;
 use isr::scene::{cornell::cornell_box, Scene};
 use isr::settings::{Method, RenderSettings};

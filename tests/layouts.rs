@@ -2,9 +2,10 @@
 //! structs of `shaders/shared.glsl`, read from the compiled SPIR-V.
 
 use isr::gpu_types::{
-    DrawPush, FrameUniforms, GridLevelPush, HisrCutHeader, InstanceTransform, LightPatch,
-    MaterialGpu, RunUniforms, VoxelizePush,
+    DrawPush, FrameUniforms, GridLevelPush, InstanceTransform, LightPatch, MaterialGpu,
+    RunUniforms, VoxelizePush,
 };
+use isr::methods::hisr::gpu::HisrCutHeader;
 use std::collections::HashMap;
 use std::mem::{offset_of, size_of};
 
@@ -125,10 +126,10 @@ fn frame_uniforms_match_shared_glsl() {
 fn run_uniforms_match_shared_glsl() {
     for shader in [
         "direct_light.frag",
-        "multires/gather.frag",
+        "hisr/gather.frag",
         "multires/upsample.comp",
     ] {
-        check!(shader, RunUniforms, "RunUniforms", pad0: 4, [
+        check!(shader, RunUniforms, "RunUniforms", pad2: 4, [
             shadow_normal_offset => "shadow_normal_offset",
             shadow_depth_bias => "shadow_depth_bias",
             pcf_radius => "pcf_radius",
@@ -141,21 +142,14 @@ fn run_uniforms_match_shared_glsl() {
             depth_threshold => "depth_threshold",
             normal_chord => "normal_chord",
             hierarchy_flags => "hierarchy_flags",
-            vpl_level => "vpl_level",
-            vpl_side => "vpl_side",
             validity_depth => "validity_depth",
             validity_normal_cos => "validity_normal_cos",
-            isr_base_level => "isr_base_level",
-            hisr_threshold => "hisr_threshold",
-            hisr_start_depth => "hisr_start_depth",
-            hisr_max_depth => "hisr_max_depth",
-            splat_threshold => "splat_threshold",
-            hisr_tau => "hisr_tau",
-            hisr_tau_mode => "hisr_tau_mode",
             patch_kernel => "patch_kernel",
             grid_side => "grid_side",
             grid_levels => "grid_levels",
             pad0 => "pad0",
+            pad1 => "pad1",
+            pad2 => "pad2",
         ]);
     }
 }
@@ -179,11 +173,7 @@ fn light_patch_matches_shared_glsl() {
 
 #[test]
 fn hisr_cut_header_matches_shared_glsl() {
-    for shader in [
-        "hisr/cut.comp",
-        "multires/gather.frag",
-        "hisr/visibility.comp",
-    ] {
+    for shader in ["hisr/cut.comp", "hisr/gather.frag", "hisr/visibility.comp"] {
         check!(shader, HisrCutHeader, "HisrCutHeader", points: 16, [
             tiles => "tiles",
             entries => "entries",
@@ -250,29 +240,30 @@ fn viewer_pushes_match_shared_glsl() {
     }
 }
 
+/// The value of `const ... NAME = VALUE;` in `shaders/FILE`.
+fn glsl_constant(file: &str, name: &str) -> String {
+    let path = format!("{}/shaders/{file}", env!("CARGO_MANIFEST_DIR"));
+    let glsl = std::fs::read_to_string(&path).unwrap();
+    let line = glsl
+        .lines()
+        .find(|l| l.starts_with("const ") && l.contains(&format!(" {name} = ")))
+        .unwrap_or_else(|| panic!("{name} not in {path}"));
+    line.split('=')
+        .nth(1)
+        .unwrap()
+        .split(';')
+        .next()
+        .unwrap()
+        .trim()
+        .trim_end_matches('u')
+        .to_string()
+}
+
 /// The flag constants are written twice (GLSL and Rust); read GLSL's.
 #[test]
 fn flag_constants_match_shared_glsl() {
-    let glsl = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/shared.glsl"))
-        .unwrap();
-    let value = |name: &str| -> u32 {
-        let line = glsl
-            .lines()
-            .find(|l| l.contains(&format!(" {name} = ")))
-            .unwrap_or_else(|| panic!("{name} not in shared.glsl"));
-        let v = line
-            .split('=')
-            .nth(1)
-            .unwrap()
-            .split(';')
-            .next()
-            .unwrap()
-            .trim()
-            .trim_end_matches('u');
-        v.parse().unwrap()
-    };
+    let value = |name: &str| -> u32 { glsl_constant("shared.glsl", name).parse().unwrap() };
     use isr::gpu_types::*;
-    assert_eq!(value("HIERARCHY_POINT_VPLS"), HIERARCHY_POINT_VPLS as u32);
     assert_eq!(value("HIERARCHY_STENCIL_OFF"), HIERARCHY_STENCIL_OFF as u32);
     assert_eq!(value("GEO_HAS_GEOMETRY"), GEO_HAS_GEOMETRY);
     assert_eq!(value("GEO_SMOOTH"), GEO_SMOOTH);
@@ -281,36 +272,36 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(value("PRESENT_VIEW_INDIRECT"), PRESENT_VIEW_INDIRECT as u32);
     assert_eq!(value("PRESENT_VIEW_HOST"), PRESENT_VIEW_HOST as u32);
     assert_eq!(value("LIGHT_SPOT"), LIGHT_SPOT as u32);
-    assert_eq!(value("HISR_CUT_OVERFLOW"), HISR_CUT_OVERFLOW);
-    assert_eq!(value("HISR_CUT_LEVELS"), HISR_CUT_LEVELS as u32);
-    assert_eq!(value("HISR_TAU_RELATIVE"), HISR_TAU_RELATIVE as u32);
-    assert_eq!(value("HISR_TAU_ABSOLUTE"), HISR_TAU_ABSOLUTE as u32);
     assert_eq!(value("LIGHT_POINT"), LIGHT_POINT as u32);
+    assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
     assert_eq!(value("PATCH_KERNEL_CENTRE"), PATCH_KERNEL_CENTRE as u32);
     assert_eq!(
         value("PATCH_KERNEL_SECOND_ORDER"),
         PATCH_KERNEL_SECOND_ORDER as u32
     );
-    assert_eq!(value("LIGHT_DIRECTIONAL"), LIGHT_DIRECTIONAL as u32);
-    let float = |name: &str| -> f32 {
-        let line = glsl
-            .lines()
-            .find(|l| l.contains(&format!(" {name} = ")))
-            .unwrap();
-        line.split('=')
-            .nth(1)
-            .unwrap()
-            .split(';')
-            .next()
-            .unwrap()
-            .trim()
-            .parse()
-            .unwrap()
-    };
+    let float = |name: &str| -> f32 { glsl_constant("shared.glsl", name).parse().unwrap() };
     assert_eq!(float("PATCH_EMPTY"), PATCH_EMPTY);
     assert_eq!(float("PATCH_VALID"), PATCH_VALID);
     assert_eq!(float("PATCH_INVALID"), PATCH_INVALID);
-    assert_eq!(float("HISR_INVALID_TAU_SCALE"), HISR_INVALID_TAU_SCALE);
+}
+
+/// HISR's constants (`methods::hisr::gpu`) against `shaders/hisr/hisr.glsl`.
+#[test]
+fn hisr_constants_match_hisr_glsl() {
+    use isr::methods::hisr::gpu::*;
+    let text = |name: &str| glsl_constant("hisr/hisr.glsl", name);
+    assert_eq!(
+        text("HISR_CUT_OVERFLOW").parse::<u32>().unwrap(),
+        HISR_CUT_OVERFLOW
+    );
+    assert_eq!(
+        text("HISR_CUT_LEVELS").parse::<usize>().unwrap(),
+        HISR_CUT_LEVELS
+    );
+    assert_eq!(
+        text("HISR_INVALID_TAU_SCALE").parse::<f32>().unwrap(),
+        HISR_INVALID_TAU_SCALE
+    );
 }
 
 #[test]

@@ -5,9 +5,11 @@ mod common;
 use common::cli::Isr;
 use common::*;
 use glam::Vec3;
-use isr::gpu_types::{HISR_INVALID_TAU_SCALE, PATCH_INVALID};
-use isr::methods::{hisr, isr::BASE, vpls::VPLS};
+use isr::gpu_types::PATCH_INVALID;
+use isr::methods::hisr::gpu::HISR_INVALID_TAU_SCALE;
+use isr::methods::{hisr, isr::BASE};
 use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
+use isr::regular_vpls::VPLS;
 use isr::scene::{cornell::cornell_box, Camera, LightKind};
 use isr::settings::{Method, RenderSettings};
 
@@ -120,7 +122,7 @@ fn isr_without_merges_equals_regular_sampling_at_its_base_level() {
         .with(&VALIDITY_NORMAL, 0.0);
     let mut r = isr::renderer::Renderer::new(&gpu, &scene, &no_merges).unwrap();
     r.render_frames(1, |_| {}).unwrap();
-    let chosen = r.isr_chosen().unwrap().unwrap();
+    let chosen = r.light_patches().unwrap().unwrap();
     let isr_indirect = r.readback().unwrap().indirect;
     drop(r);
     assert_validation_clean(&gpu);
@@ -178,7 +180,7 @@ fn isr_chosen_patches_partition_the_rsm_flux() {
     let s = settings(Method::new("isr"), 128).with(&BASE, 32);
     let mut r = isr::renderer::Renderer::new(&gpu, &cornell_box(), &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
-    let chosen = r.isr_chosen().unwrap().unwrap();
+    let chosen = r.light_patches().unwrap().unwrap();
     let rsm = r.readback().unwrap().rsm;
     drop(r);
     assert_validation_clean(&gpu);
@@ -320,7 +322,7 @@ fn packed_tree_matches(mode: hisr::TauMode) {
         .with(&hisr::TAU_MODE, mode);
     let mut r = isr::renderer::Renderer::new(&gpu, &scene, &s).unwrap();
     r.render_frames(1, |_| {}).unwrap();
-    let packed = r.hisr_packed_tree().unwrap().expect("hisr packs its tree");
+    let packed = r.light_patches().unwrap().expect("hisr packs its tree");
     let m = r.readback_multires().unwrap().unwrap();
     drop(r);
     assert_validation_clean(&gpu);

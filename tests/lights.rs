@@ -153,7 +153,7 @@ fn isr_merges_a_flat_floor_under_cube_faces_and_orthographic_rsms() {
             }
             r.set_only_view(Some(view)).unwrap();
             r.render_frames(1, |_| {}).unwrap();
-            let chosen = r.isr_chosen().unwrap().unwrap();
+            let chosen = r.light_patches().unwrap().unwrap();
             let rsm = r.readback().unwrap().rsm;
             drop(r);
             let flux: f64 = rsm.flux.iter().map(|t| t[0] as f64).sum();

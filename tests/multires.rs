@@ -4,8 +4,9 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use isr::methods::vpls::{VplSampling, VPLS, VPL_SAMPLING};
 use isr::multires::{Upsample, DEPTH_THRESHOLD, NORMAL_THRESHOLD, STENCIL, UPSAMPLE};
+use isr::regular_vpls::RegularVpls;
+use isr::regular_vpls::{VplSampling, VPLS, VPL_SAMPLING};
 use isr::scene::{cornell::cornell_box, Camera, Scene};
 use isr::settings::RenderSettings;
 
@@ -197,7 +198,8 @@ fn discontinuity_on_a_texel_border_is_not_missed() {
 #[test]
 fn level_zero_gather_equals_the_cpu_sum() {
     let gpu = gpu();
-    let out = render_multires(&gpu, &cornell_box(), &level_zero_only(128, 96));
+    let s = level_zero_only(128, 96);
+    let out = render_multires(&gpu, &cornell_box(), &s);
     let m = &out.multires;
     assert!(
         out.stats.patches_per_level.as_ref().unwrap()[1..]
@@ -205,7 +207,7 @@ fn level_zero_gather_equals_the_cpu_sum() {
             .all(|&c| c == 0),
         "only level 0"
     );
-    let k = out.run.vpl_level as usize;
+    let k = RegularVpls::of(&s).level as usize;
     assert_eq!(m.rsm_tree[k][0].len(), 256, "256 VPLs at level {k}");
     let vpls = vpls_at(m, k);
     let mut checked = 0;
@@ -248,9 +250,10 @@ fn assert_sampled(checked: usize, stride: usize, out: &RenderedMultires, coverag
 #[test]
 fn every_patch_holds_the_cpu_sum_at_its_mean_position_and_normal() {
     let gpu = gpu();
-    let out = render_multires(&gpu, &cornell_box(), &settings(128, 128));
+    let s = settings(128, 128);
+    let out = render_multires(&gpu, &cornell_box(), &s);
     let m = &out.multires;
-    let vpls = vpls_at(m, out.run.vpl_level as usize);
+    let vpls = vpls_at(m, RegularVpls::of(&s).level as usize);
     let w = m.width;
     let mut checked = vec![0; m.levels as usize + 1];
     for (l, count) in checked.iter_mut().enumerate() {
@@ -422,7 +425,7 @@ fn point_sampled_vpls_scale_flux_by_the_patch_size() {
     let s = level_zero_only(64, 64).with(&VPL_SAMPLING, VplSampling::Point);
     let out = render_multires(&gpu, &cornell_box(), &s);
     let m = &out.multires;
-    let k = out.run.vpl_level as usize;
+    let k = RegularVpls::of(&s).level as usize;
     let span = 1usize << k;
     let r = m.rsm_tree[0][0].len().isqrt();
     // Centre texels of each patch, flux and area scaled by span^2.

@@ -284,7 +284,7 @@ fn cpu_level(
 fn rsm_quadtree_matches_an_independent_cpu_reduction() {
     let gpu = gpu();
     let scene = isr::scene::cornell::cornell_box();
-    let settings = sized("multires-gather", 64, 64, 64).with(&isr::methods::vpls::VPLS, 16);
+    let settings = sized("multires-gather", 64, 64, 64).with(&isr::regular_vpls::VPLS, 16);
     let m = render_multires(&gpu, &scene, &settings).multires;
     use isr::passes::rsm_tree::{VALIDITY_DEPTH, VALIDITY_NORMAL};
     let light = scene.lights[0].position.as_dvec3();

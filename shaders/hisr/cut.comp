@@ -115,7 +115,7 @@ void main() {
     uint base = layout_.entries[1 + level] + t * capacity;
     // Roots: the start depth's nodes for the coarsest level, else the parent
     // tile's traverse entries (its evaluate entries hold for this tile too).
-    int start = run.hisr_start_depth;
+    int start = HISR_START_DEPTH;
     int side = 1 << start;
     uint roots = uint(side * side);
     uint parent_last = 0u;
@@ -139,7 +139,7 @@ void main() {
         return;
     }
     uint evaluate = 0u, traverse = 0u;
-    // Depth-first from each root, without a stack (as multires/gather.frag's
+    // Depth-first from each root, without a stack (as hisr/gather.frag's
     // traverse_from), so the entries come in the same order every frame.
     for (uint r = 0u; r < roots; ++r) {
         ivec3 root = level + 1 < HISR_CUT_LEVELS ? cut_node(cut[parent_last - r])

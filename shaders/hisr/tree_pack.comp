@@ -21,7 +21,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
-layout(set = 1, binding = 3, std430) writeonly buffer LightTree {
+layout(set = 1, binding = 3, std430) writeonly buffer LightPatches {
     uint count;  // nodes packed, (4^(D+1) - 1) / 3
     uint pad0, pad1, pad2;
     LightPatch nodes[];
@@ -29,7 +29,7 @@ layout(set = 1, binding = 3, std430) writeonly buffer LightTree {
 
 void main() {
     int top = run.rsm_top_level;  // mip of the root
-    int w = 1 << run.hisr_max_depth;  // 2^D patches per side at the max depth
+    int w = 1 << HISR_MAX_DEPTH;  // 2^D patches per side at the max depth
     int i = int(gl_GlobalInvocationID.y) * w + int(gl_GlobalInvocationID.x);
     int total = (4 * w * w - 1) / 3;
     if (gl_GlobalInvocationID.x >= uint(w) || i >= total) return;

@@ -27,7 +27,7 @@
 #include "hisr/tile_points.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-// --hisr-shared-refine (multires/gather.frag's REFINE_SPREAD): the corners' spread
+// --hisr-shared-refine (hisr/gather.frag's REFINE_SPREAD): the corners' spread
 // past which every receiver marches an entry itself; 1: none does.
 layout(constant_id = 31) const float REFINE_SPREAD = 1.0;
 

@@ -19,14 +19,17 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
-layout(set = 1, binding = 3, std430) buffer ChosenPatches {
+// The base level (methods::isr::base_level, from --isr-base).
+layout(constant_id = 70) const int ISR_BASE_LEVEL = 0;
+
+layout(set = 1, binding = 3, std430) buffer LightPatches {
     uint count;
     uint pad0, pad1, pad2;
     LightPatch patches[];
 };
 
 void main() {
-    int base = run.isr_base_level;
+    int base = ISR_BASE_LEVEL;
     int top = run.rsm_top_level;
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, textureSize(rsm_position, base)))) return;

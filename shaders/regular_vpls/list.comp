@@ -1,9 +1,9 @@
 #version 460
-// Pass `vpl-list` (multires-gather, docs/algorithm.md section 4.1): the N
-// regular VPLs written once per frame into one buffer, VPL j at entry j (an
-// empty one with zero area, which the gather skips), so every eye-space patch
-// reads each VPL with one load of the same address instead of three texel
-// fetches from a mip level, the same loop as Basic ISR's list.
+// Pass `vpl-list` (docs/algorithm.md section 4.1): the N regular VPLs
+// written once per frame into one buffer, VPL j at entry j (an empty one with
+// zero area, which the gather skips), so every eye-space patch reads each VPL
+// with one load of the same address instead of three texel fetches from a
+// mip level (multires/gather_list.frag).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -11,7 +11,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = 0) uniform sampler2D rsm_position;  // quadtree (mip chain)
 layout(set = 1, binding = 1) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 2) uniform sampler2D rsm_flux;
-layout(set = 1, binding = 3, std430) writeonly buffer VplList {
+layout(set = 1, binding = 3, std430) writeonly buffer LightPatches {
     uint count;  // N: every entry, empty or not
     uint pad0, pad1, pad2;
     LightPatch vpls[];
@@ -20,7 +20,7 @@ layout(set = 1, binding = 3, std430) writeonly buffer VplList {
 #include "regular_vpls/regular_vpls.glsl"
 
 void main() {
-    int side = run.vpl_side;
+    int side = VPL_SIDE;
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(xy, ivec2(side)))) return;
     int j = xy.y * side + xy.x;

@@ -2,13 +2,16 @@
 // Methods rsm-splat and rsm-splat-restricted (docs/algorithm.md section 5): VPL j
 // (the instance) draws one quad; its fragments add that VPL's irradiance.
 // Full screen, or (RESTRICTED) the screen rectangle of the sphere where the
-// VPL's contribution can exceed run.splat_threshold: with both cosines at most 1 and
+// VPL's contribution can exceed SPLAT_THRESHOLD: with both cosines at most 1 and
 // A_j >= 0, E <= Phi_max / (pi d^2), so beyond d = sqrt(Phi_max / (pi t)) it
 // is below t. Empty VPLs draw nothing.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 
 layout(constant_id = 50) const bool RESTRICTED = false;
+// The irradiance bound (W/m^2) past which a restricted splat ends
+// (methods::rsm_splat, --splat-threshold).
+layout(constant_id = 51) const float SPLAT_THRESHOLD = 0.0;
 
 layout(set = 1, binding = 2) uniform sampler2D rsm_position;
 layout(set = 1, binding = 3) uniform sampler2D rsm_normal;
@@ -39,8 +42,8 @@ void main() {
     vec3 flux;
     bool live = regular_vpl(gl_InstanceIndex, pos, nrm, flux);
     vec4 rect = vec4(-1.0, -1.0, 1.0, 1.0);
-    if (live && RESTRICTED && run.splat_threshold > 0.0) {
-        float radius = sqrt(max(flux.r, max(flux.g, flux.b)) / (PI * run.splat_threshold));
+    if (live && RESTRICTED && SPLAT_THRESHOLD > 0.0) {
+        float radius = sqrt(max(flux.r, max(flux.g, flux.b)) / (PI * SPLAT_THRESHOLD));
         rect = screen_bounds(pos.xyz, radius);
     }
     const vec2 quad[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(1, 0), vec2(1, 1), vec2(0, 1));

@@ -83,7 +83,7 @@ pub struct BenchArgs {
     /// Parameters every point renders with, where its sweep does not set
     /// them (`--levels 4`: every multiresolution method at 4 levels).
     #[command(flatten)]
-    pub params: crate::methods::ParamArgsButVisibility,
+    pub params: crate::method_args::ParamArgsButVisibility,
 }
 
 impl Default for BenchArgs {

@@ -1,7 +1,7 @@
 //! The ratios a bench run reports (printed, in `results.json` and in
-//! `report.md`): HISR's speedups and errors against the other methods at
-//! equal error or time, its front, and flicker ratios, each computed from the
-//! rows of one visibility.
+//! `report.md`): the subject's (`methods::SUBJECT`, the paper's method)
+//! speedups and errors against the other methods at equal error or time, its
+//! front, and flicker ratios, each computed from the rows of one visibility.
 
 use super::rows::Row;
 use super::visibility::visibilities;
@@ -22,7 +22,7 @@ pub(super) fn regular() -> Vec<&'static str> {
     crate::methods::REGISTRY
         .iter()
         .filter(|&&d| {
-            crate::methods::params_of(d).any(|p| p.name() == crate::methods::vpls::VPLS.name)
+            crate::methods::params_of(d).any(|p| p.name() == crate::regular_vpls::VPLS.name)
         })
         .map(|d| d.key().name())
         .collect()
@@ -70,11 +70,16 @@ pub(super) fn with_visibility(rows: &[Row], v: &str) -> Vec<Row> {
     rows.iter().filter(|r| r.visibility == v).cloned().collect()
 }
 
-/// The ratios of the issue, per scene and visibility (each from the rows of
-/// one visibility alone): HISR's indirect-time speedup over each regular
-/// method with 256 VPLs at equal or lower error, over multires-gather with
-/// 4096 at its error, the error HISR reaches in the time of 256 regular
-/// VPLs, and HISR's flicker against 256 and 4096 regular VPLs.
+/// The subject's name (`methods::SUBJECT`).
+fn subject() -> &'static str {
+    crate::methods::SUBJECT.name()
+}
+
+/// The ratios per scene and visibility (each from the rows of one
+/// visibility alone): the subject's indirect-time speedup over each regular
+/// method with 256 and 4096 VPLs at equal or lower error, the error it
+/// reaches in the time of 256 regular VPLs, its front, and its flicker
+/// against 256 and 4096 regular VPLs.
 pub fn ratios(rows: &[Row]) -> Vec<Ratio> {
     visibilities(rows)
         .into_iter()
@@ -101,33 +106,34 @@ fn ratios_of(rows: &[Row], visibility: &str) -> Vec<Ratio> {
                 detail,
             })
         };
-        for (base, n) in regular()
-            .into_iter()
-            .map(|b| (b, 256))
-            .chain([("multires-gather", 4096)])
-        {
+        let subject = subject();
+        for (base, n) in regular().into_iter().flat_map(|b| [(b, 256), (b, 4096)]) {
             let Some(b) = find(rows, s, base, n) else {
                 continue;
             };
-            match fastest_at_most(rows, s, "hisr", b.rel_rmse_indirect) {
+            let m = format!("speedup of {subject} over {base} {n} at equal or lower error");
+            match fastest_at_most(rows, s, subject, b.rel_rmse_indirect) {
                 Some(h) => push(
-                    format!("speedup of hisr over {base} {n} at equal or lower error"),
+                    m,
                     Some(ms(b) / ms(h)),
                     format!("{} against {}", describe(h), describe(b)),
                 ),
                 None => push(
-                    format!("speedup of hisr over {base} {n} at equal or lower error"),
+                    m,
                     None,
-                    format!("no hisr setting reaches RMSE {:.3}", b.rel_rmse_indirect),
+                    format!(
+                        "no {subject} setting reaches RMSE {:.3}",
+                        b.rel_rmse_indirect
+                    ),
                 ),
             }
         }
-        for base in ["multires-splat", "multires-gather"] {
+        for base in regular() {
             let Some(b) = find(rows, s, base, 256) else {
                 continue;
             };
-            let m = format!("hisr error in the time of {base} 256 (relative to its error)");
-            match best_within(rows, s, "hisr", ms(b)) {
+            let m = format!("{subject} error in the time of {base} 256 (relative to its error)");
+            match best_within(rows, s, subject, ms(b)) {
                 Some(h) => push(
                     m,
                     Some(h.rel_rmse_indirect / b.rel_rmse_indirect),
@@ -136,29 +142,33 @@ fn ratios_of(rows: &[Row], visibility: &str) -> Vec<Ratio> {
                 None => push(
                     m,
                     None,
-                    format!("every hisr setting is slower than {:.1} ms", ms(b)),
+                    format!("every {subject} setting is slower than {:.1} ms", ms(b)),
                 ),
             }
         }
-        let (front, detail) = hisr_front(rows, s);
+        let (front, detail) = front(rows, s);
         push(
-            "least speedup of hisr over any other method's point at equal or lower error".into(),
+            format!(
+                "least speedup of {subject} over any other method's point at equal or lower error"
+            ),
             front,
             detail,
         );
-        let hisr = rows
+        let default = rows
             .iter()
-            .find(|r| r.scene == s && r.method == "hisr" && r.is_default);
-        for n in [256, 4096] {
-            let (Some(h), Some(b)) = (hisr, find(rows, s, "multires-gather", n)) else {
-                continue;
-            };
-            if let (Some(fh), Some(fb)) = (h.flicker, b.flicker) {
-                push(
-                    format!("flicker of hisr (default) / multires-gather {n}"),
-                    Some(fh / fb),
-                    format!("{fh:.4} against {fb:.4}"),
-                );
+            .find(|r| r.scene == s && r.method == subject && r.is_default);
+        for base in regular() {
+            for n in [256, 4096] {
+                let (Some(h), Some(b)) = (default, find(rows, s, base, n)) else {
+                    continue;
+                };
+                if let (Some(fh), Some(fb)) = (h.flicker, b.flicker) {
+                    push(
+                        format!("flicker of {subject} (default) / {base} {n}"),
+                        Some(fh / fb),
+                        format!("{fh:.4} against {fb:.4}"),
+                    );
+                }
             }
         }
         // What the flicker measure must tell apart (section 6.3): 64
@@ -199,19 +209,20 @@ pub(super) fn flicker_64_over_4096(
     Some((low, pixel))
 }
 
-/// Whether HISR's curve lies below every other method's (the issue's goal on
-/// the open scene): over every point of every other method in `scene`, the
-/// speedup of the fastest HISR point at equal or lower error; the least of
-/// them, the point it was, and how many points lie below every HISR error
-/// (where HISR has no point to compare).
-fn hisr_front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
+/// Whether the subject's curve lies below every other method's: over every
+/// point of every other method in `scene` but the reference, the speedup of
+/// the subject's fastest point at equal or lower error; the least of them,
+/// the point it was, and how many points lie below every error of the
+/// subject (where it has no point to compare).
+fn front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
+    let (subject, reference) = (subject(), crate::methods::REFERENCE.name());
     let mut least: Option<(f64, &Row, &Row)> = None;
     let (mut reached, mut unreached) = (0, 0);
     let others = rows.iter().filter(|r| {
-        r.scene == scene && r.indirect_ms.is_some() && r.method != "hisr" && r.method != "reference"
+        r.scene == scene && r.indirect_ms.is_some() && r.method != subject && r.method != reference
     });
     for b in others {
-        let Some(h) = fastest_at_most(rows, scene, "hisr", b.rel_rmse_indirect) else {
+        let Some(h) = fastest_at_most(rows, scene, subject, b.rel_rmse_indirect) else {
             unreached += 1;
             continue;
         };
@@ -222,7 +233,7 @@ fn hisr_front(rows: &[Row], scene: &str) -> (Option<f64>, String) {
         }
     }
     let below = format!(
-        "{unreached} of {} points below every hisr error",
+        "{unreached} of {} points below every {subject} error",
         reached + unreached
     );
     match least {

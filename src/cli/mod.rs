@@ -410,7 +410,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let light_stats = match &multires {
         Some(m) => Some(crate::debug_view::light_patch_stats(
             m,
-            renderer.isr_chosen_count()?,
+            renderer.light_patches_chosen()?,
         )),
         None => None,
     };

@@ -1,9 +1,10 @@
 //! The options `isr render` and `isr view` share ([`RunArgs`]: the scene, the
 //! method and its parameters, the sizes, the device), flattened into both
-//! commands; the method parameters (`methods::ParamArgs`) are flattened into
+//! commands; the method parameters (`method_args::ParamArgs`) are flattened into
 //! `isr bench` too.
 
-use crate::methods::{self, ParamArgs};
+use crate::method_args::ParamArgs;
+use crate::methods;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::{GpuOptions, Validation};
 use anyhow::{bail, Result};

@@ -1,21 +1,21 @@
 //! Method `isr` (Basic image-space radiosity, docs/algorithm.md section 4): per
 //! frame, the largest valid patches of the RSM quadtree above a dense base
 //! level, compacted on the GPU into one list that every eye-space patch
-//! gathers from (`methods::gather`).
+//! gathers from (the multiresolution framework's list gather).
 //!
-//! Pass `isr-select`: `shaders/isr/select.comp`, one dispatch over the base
-//! level with an atomic append (a [`PatchListPass`]). Reads the RSM quadtree;
-//! writes the chosen list.
+//! Its light-space source, pass `isr-select`: `shaders/isr/select.comp`, one
+//! dispatch over the base level with an atomic append (a [`PatchList`]).
+//! Reads the RSM quadtree; writes the chosen list.
 
-use super::gather::{GatherPass, LightPatches};
-use super::multires_method::{MultiresMethod, PatchList, PatchListPass};
 use super::{Descriptor, IndirectMethod};
 use crate::frame::Setup;
-use crate::gpu_types::{LightPatch, RunUniforms};
+use crate::gpu_types::LightPatch;
+use crate::multires::{MultiresMethod, PatchList};
 use crate::passes::rsm_tree;
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
-use anyhow::{anyhow, bail, Result};
+use crate::vk::pipeline::Spec;
+use anyhow::{bail, Result};
 
 pub const KEY: Method = Method::new("isr");
 
@@ -71,9 +71,6 @@ impl Descriptor for IsrMethod {
     fn memory(&self, s: &RenderSettings) -> u64 {
         base_texels(s) * std::mem::size_of::<LightPatch>() as u64
     }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        u.isr_base_level = base_level(s) as i32;
-    }
     fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
         let bases: &[u32] = if quick { &[16, 64] } else { &[16, 32, 64] };
         bases
@@ -87,26 +84,21 @@ impl Descriptor for IsrMethod {
     }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
         // At most one chosen patch per base texel, one invocation each.
-        let base_extent = setup
-            .targets
-            .rsm_position
-            .mip_extent(base_level(setup.settings));
-        let select = PatchListPass::new(
+        let base = base_level(setup.settings);
+        let select = PatchList::new(
             setup,
-            PatchList::IsrChosen,
-            ("isr-select", "isr/select.comp", "ChosenPatches"),
+            (
+                "isr-select",
+                "isr/select.comp",
+                &[Spec::int("ISR_BASE_LEVEL", base as i32)],
+            ),
+            true,
             base_texels(setup.settings),
-            base_extent,
+            setup.targets.rsm_position.mip_extent(base),
         )?;
-        let method = MultiresMethod::new(setup, Some(Box::new(select)), |setup, m, chosen| {
-            let chosen = chosen.ok_or_else(|| anyhow!("isr gathers from its chosen list"))?;
-            Ok(Box::new(GatherPass::new(
-                setup,
-                m,
-                LightPatches::List,
-                chosen,
-            )?))
-        })?;
-        Ok(Box::new(method))
+        Ok(Box::new(MultiresMethod::gathering(
+            setup,
+            Box::new(select),
+        )?))
     }
 }

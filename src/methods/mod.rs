@@ -1,41 +1,38 @@
 //! Indirect-light methods, one module each (docs/algorithm.md sections 4 and
-//! 5). A method is one unit: its module declares what it is (a
-//! [`Descriptor`]: name, help, parameters with their ranges, capabilities,
-//! checks, GPU memory, uniforms, bench sweep) and makes the object that
-//! records its passes (an [`IndirectMethod`]), which writes the
-//! full-resolution indirect irradiance image `Targets::indirect`, either
-//! through the multiresolution buffer ([`multires_method::MultiresMethod`])
-//! or directly at full resolution.
+//! 5), and the registry that lists them. A method is one unit: its module
+//! declares what it is (a [`Descriptor`]: name, help, parameters with their
+//! ranges, capabilities, checks, GPU memory, uniforms, bench sweep) and
+//! makes the object that records its passes (an [`IndirectMethod`]), which
+//! writes the full-resolution indirect irradiance image `Targets::indirect`,
+//! either through the multiresolution buffer (`multires::MultiresMethod`,
+//! with a light-space source of its own, `multires::LightSource`) or
+//! directly at full resolution.
 //!
 //! Adding a method: its module here (a `Descriptor` and its passes), its
-//! shaders in `shaders/`, and one line in [`REGISTRY`]. `settings::Method`
-//! is only its key; the CLI, checks, viewer and bench read the rest from
-//! the registry.
+//! shaders in a folder of their own (`shaders/<method>/`), and one line in
+//! [`REGISTRY`] (with its `mod` line above). `settings::Method` is only its
+//! key; the CLI, checks, viewer and bench read the rest from the registry,
+//! and no shared module names it (`tests/house_rules.rs`).
 
-pub mod args;
-pub mod gather;
 pub mod hisr;
 pub mod isr;
 pub mod lpv;
 pub mod multires_gather;
-pub mod multires_method;
 pub mod multires_splat;
 pub mod none;
 pub mod reference;
 pub mod rsm_gather;
 pub mod rsm_splat;
-pub mod vpls;
 
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
-use crate::multires::{self, MultiresBuffer};
+use crate::multires::{self, LightPatches, MultiresBuffer, MultiresMethod};
+use crate::regular_vpls;
 use crate::settings::params::AnyParam;
 use crate::settings::{Method, Params, RenderSettings};
 use crate::vk::profiler::Profiler;
-use crate::vk::Buffer;
 use crate::{visibility, voxel_grid};
 use anyhow::{anyhow, bail, Result};
-pub use args::{ParamArgs, ParamArgsButVisibility};
 
 /// Every method, in the order of the CLI's help, the viewer's `M` key and
 /// the bench's reports: the baselines, then the paper's methods, then the
@@ -52,6 +49,14 @@ pub static REGISTRY: &[&dyn Descriptor] = &[
     &lpv::LpvMethod,
     &reference::ReferenceMethod,
 ];
+
+/// The method the bench measures the others against (its headline ratios:
+/// speedups at equal error, its front): the paper's.
+pub const SUBJECT: Method = hisr::KEY;
+
+/// The dense reference: the converged limit the approximations are measured
+/// against (method error), left out of the other methods' fronts.
+pub const REFERENCE: Method = reference::KEY;
 
 /// What a method is, before anything is made: everything the CLI, the
 /// checks, the viewer and the bench need to know of it.
@@ -77,8 +82,8 @@ pub trait Descriptor: Sync {
         false
     }
 
-    /// Whether it reads the N regular VPLs of `--vpls`: their parameters,
-    /// check and uniforms then come with it (`vpls`), and its bench sweep
+    /// Whether it reads the N regular VPLs of `--vpls`: their parameters
+    /// and check then come with it (`regular_vpls`), and its bench sweep
     /// and label default to the VPL count's.
     fn reads_regular_vpls(&self) -> bool {
         false
@@ -125,7 +130,7 @@ pub trait Descriptor: Sync {
     /// bench does not sweep it. One point sets nothing or only defaults.
     fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
         match self.reads_regular_vpls() {
-            true => vpls::sweep(rsm, quick),
+            true => regular_vpls::sweep(rsm, quick),
             false => vec![],
         }
     }
@@ -133,9 +138,23 @@ pub trait Descriptor: Sync {
     /// A short label for tables and charts: "256 VPLs", "tau 0.05, depth 6".
     fn label(&self, s: &RenderSettings) -> String {
         match self.reads_regular_vpls() {
-            true => vpls::label(s),
+            true => regular_vpls::label(s),
             false => self.key().name().into(),
         }
+    }
+
+    /// Its main knob: the parameter that trades its speed for accuracy,
+    /// which `isr render -h` shows and the viewer's +/- keys scale. By
+    /// default the VPL count for a method that reads regular VPLs.
+    fn main_param(&self) -> Option<&'static dyn AnyParam> {
+        self.reads_regular_vpls()
+            .then_some(&regular_vpls::VPLS as &dyn AnyParam)
+    }
+
+    /// Warnings for settings that are valid but most likely not what was
+    /// meant (options that have no effect in this combination).
+    fn warnings(&self, _s: &RenderSettings) -> Vec<String> {
+        vec![]
     }
 
     /// Its colour in the bench's charts (sRGB). By default one of a fixed
@@ -209,7 +228,7 @@ pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyPar
         &[]
     };
     let regular: &[&dyn AnyParam] = if d.reads_regular_vpls() {
-        vpls::PARAMS
+        regular_vpls::PARAMS
     } else {
         &[]
     };
@@ -250,9 +269,6 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
     if d.uses_multires() {
         multires::write_uniforms(s, u);
     }
-    if d.reads_regular_vpls() {
-        vpls::RegularVpls::of(s).write_uniforms(s, u);
-    }
     if d.reads_visibility() {
         voxel_grid::write_uniforms(s, u);
     }
@@ -287,7 +303,7 @@ pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
         multires::check(s, d.key().name())?;
     }
     if d.reads_regular_vpls() {
-        vpls::check(s)?;
+        regular_vpls::check(s)?;
     }
     if d.reads_visibility() {
         visibility::check(s, d.key().name(), d.takes_exact_visibility())?;
@@ -347,16 +363,29 @@ pub trait IndirectMethod {
         None
     }
 
-    /// Basic ISR's list of chosen light patches (`CHOSEN_PATCHES_HEADER`, then
-    /// `LightPatch`es).
-    fn chosen_patches(&self) -> Option<&Buffer> {
+    /// The light patches its light-space source offered the gather in the
+    /// last frame, for the methods that have one (a list, or a packed tree).
+    fn light_patches(&self) -> Option<LightPatches<'_>> {
         None
     }
+}
 
-    /// HISR's packed light tree (`CHOSEN_PATCHES_HEADER`, then a `LightPatch`
-    /// per quadtree node, root first; see `shaders/hisr/tree_pack.comp`).
-    fn packed_light_tree(&self) -> Option<&Buffer> {
-        None
+/// Every method that works through the multiresolution buffer is one.
+impl IndirectMethod for MultiresMethod {
+    fn record_eye_space(&self, ctx: &FrameContext, p: &mut Profiler) {
+        MultiresMethod::record_eye_space(self, ctx, p);
+    }
+
+    fn record(&self, ctx: &FrameContext, p: &mut Profiler, _: usize) {
+        MultiresMethod::record(self, ctx, p);
+    }
+
+    fn multires(&self) -> Option<&MultiresBuffer> {
+        Some(self.buffer())
+    }
+
+    fn light_patches(&self) -> Option<LightPatches<'_>> {
+        MultiresMethod::light_patches(self)
     }
 }
 

@@ -7,13 +7,12 @@
 //! Reads the geometry mips and the RSM quadtree; writes the illumination
 //! buffer and the evaluation counts (barriers: `MultiresBuffer::fill_layers`).
 
-use super::multires_method::{FillPass, MultiresMethod};
 use super::rsm_splat::require_blending;
-use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::multires::{self, MultiresBuffer};
+use crate::multires::{self, FillPass, MultiresBuffer, MultiresMethod};
 use crate::passes::INDIRECT_GRAPHICS;
+use crate::regular_vpls::RegularVpls;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::pipeline::{Binding, Blend, GraphicsDesc, PassPipeline, StencilTest};
 use crate::vk::profiler::Profiler;
@@ -49,7 +48,7 @@ impl Descriptor for MultiresSplatMethod {
         Ok(())
     }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
-        let method = MultiresMethod::new(setup, None, |setup, m, _| {
+        let method = MultiresMethod::filled_by(setup, |setup, m| {
             Ok(Box::new(MultiresSplatPass::new(setup, m)?))
         })?;
         Ok(Box::new(method))
@@ -64,6 +63,7 @@ pub struct MultiresSplatPass {
 impl MultiresSplatPass {
     pub fn new(setup: &Setup, m: &MultiresBuffer) -> Result<Self> {
         let (gpu, t, s) = (setup.gpu, setup.targets, setup.samplers);
+        let vpls = RegularVpls::of(setup.settings);
         require_blending(gpu, m.illumination.format, "multires-splat")?;
         require_blending(gpu, m.evaluations.format, "multires-splat")?;
         let pipeline = PassPipeline::graphics(
@@ -86,13 +86,17 @@ impl MultiresSplatPass {
                 stencil_format: m.stencil.format,
                 stencil: Some(StencilTest::EQUAL_ONE),
                 blend: Blend::AdditiveAlphaMax,
-                specialization: &crate::visibility::specialization(setup.settings),
+                specialization: &[
+                    &crate::visibility::specialization(setup.settings)[..],
+                    &vpls.specialization(setup.settings),
+                ]
+                .concat(),
                 ..Default::default()
             },
         )?;
         Ok(Self {
             pipeline,
-            vpls: RegularVpls::of(setup.settings).count,
+            vpls: vpls.count,
         })
     }
 }

@@ -17,11 +17,10 @@
 
 use super::rsm_gather::full_resolution_bindings;
 use super::rsm_splat::require_blending;
-use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, push_bytes, Attachments, INDIRECT_GRAPHICS};
+use crate::regular_vpls::RegularVpls;
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, RenderSettings};
 use crate::visibility;
@@ -70,9 +69,6 @@ impl Descriptor for ReferenceMethod {
     fn interactive(&self) -> bool {
         false
     }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        RegularVpls::every_texel(s).write_uniforms(s, u);
-    }
     fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
         Some(RegularVpls::every_texel(s).count as u64)
     }
@@ -104,7 +100,11 @@ impl Reference {
                 push_constant_bytes: 8,
                 color_formats: &[format],
                 blend: Blend::Additive,
-                specialization: &crate::visibility::specialization(s),
+                specialization: &[
+                    &crate::visibility::specialization(s)[..],
+                    &RegularVpls::every_texel(s).specialization(s),
+                ]
+                .concat(),
                 ..Default::default()
             },
         )?;

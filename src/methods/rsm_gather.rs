@@ -3,10 +3,10 @@
 //! `rsm-gather`, `shaders/rsm_gather/gather.frag` (barriers: `FullscreenPass::record`).
 //! Reads the G-buffer and the RSM quadtree; writes `indirect`.
 
-use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
 use crate::passes::{push_bytes, FullscreenPass, INDIRECT_GRAPHICS};
+use crate::regular_vpls::RegularVpls;
 use crate::settings::{Method, RenderSettings};
 use crate::vk::pipeline::Binding;
 use crate::vk::profiler::Profiler;
@@ -63,7 +63,11 @@ impl RsmGather {
             INDIRECT_GRAPHICS,
             (
                 "rsm_gather/gather.frag",
-                &crate::visibility::specialization(setup.settings),
+                &[
+                    &crate::visibility::specialization(setup.settings)[..],
+                    &RegularVpls::of(setup.settings).specialization(setup.settings),
+                ]
+                .concat(),
             ),
             &full_resolution_bindings(setup),
             8,

@@ -7,15 +7,14 @@
 //! writes `indirect` (barriers below).
 
 use super::rsm_gather::full_resolution_bindings;
-use super::vpls::RegularVpls;
 use super::{Descriptor, IndirectMethod};
 use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::RunUniforms;
 use crate::passes::{begin_rendering, Attachments, INDIRECT_GRAPHICS};
+use crate::regular_vpls::RegularVpls;
 use crate::settings::params::{AnyParam, DefaultValue, Param, Range};
 use crate::settings::{Method, RenderSettings};
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, PassPipeline, Spec};
 use crate::vk::profiler::Profiler;
 use crate::vk::Gpu;
 use anyhow::{bail, Result};
@@ -71,11 +70,6 @@ impl Descriptor for RsmSplatMethod {
             true => &[RESTRICTED_PARAMS],
         }
     }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        if self.restricted {
-            u.splat_threshold = THRESHOLD.get(s);
-        }
-    }
     /// Full-screen splats evaluate every VPL at every pixel; restricted ones
     /// fewer, uncounted.
     fn evaluations_per_pixel(&self, s: &RenderSettings) -> Option<u64> {
@@ -107,7 +101,12 @@ impl RsmSplat {
     /// `restricted`: quads bounded by `--splat-threshold` (else full screen).
     pub fn new(setup: &Setup, restricted: bool) -> Result<Self> {
         let format = setup.targets.indirect.format;
-        let visibility = crate::visibility::specialization(setup.settings);
+        let vpls = RegularVpls::of(setup.settings);
+        // Read only when restricted.
+        let threshold = match restricted {
+            true => THRESHOLD.get(setup.settings),
+            false => 0.0,
+        };
         require_blending(setup.gpu, format, "rsm-splat")?;
         let pipeline = PassPipeline::graphics(
             setup.gpu,
@@ -120,16 +119,20 @@ impl RsmSplat {
                 color_formats: &[format],
                 blend: Blend::Additive,
                 specialization: &[
-                    crate::vk::pipeline::Spec::bool("RESTRICTED", restricted),
-                    visibility[0],
-                    visibility[1],
-                ],
+                    &[
+                        Spec::bool("RESTRICTED", restricted),
+                        Spec::float("SPLAT_THRESHOLD", threshold),
+                    ],
+                    &crate::visibility::specialization(setup.settings)[..],
+                    &vpls.specialization(setup.settings),
+                ]
+                .concat(),
                 ..Default::default()
             },
         )?;
         Ok(Self {
             pipeline,
-            vpls: RegularVpls::of(setup.settings).count,
+            vpls: vpls.count,
         })
     }
 }

@@ -6,7 +6,6 @@ use super::Renderer;
 use crate::gpu_types::LightPatch;
 use crate::multires::MultiresBuffer;
 use crate::readback::{self, MultiresReadback, Readback};
-use crate::vk::Buffer;
 use anyhow::Result;
 
 impl Renderer<'_> {
@@ -45,23 +44,15 @@ impl Renderer<'_> {
         self.method.multires()
     }
 
-    /// The light patches Basic ISR chose in the last frame (`None` for other
-    /// methods), positions in world space.
-    pub fn isr_chosen(&self) -> Result<Option<Vec<LightPatch>>> {
-        self.patches(self.method.chosen_patches())
-    }
-
-    /// HISR's packed light tree, root first (`shaders/hisr/tree_pack.comp`),
+    /// The light patches the method's light-space source offered the
+    /// gather in the last frame (`None` for a method without one): a list,
+    /// or a packed tree root first (`shaders/hisr/tree_pack.comp`),
     /// positions in world space.
-    pub fn hisr_packed_tree(&self) -> Result<Option<Vec<LightPatch>>> {
-        self.patches(self.method.packed_light_tree())
-    }
-
-    fn patches(&self, buffer: Option<&Buffer>) -> Result<Option<Vec<LightPatch>>> {
-        let Some(b) = buffer else {
+    pub fn light_patches(&self) -> Result<Option<Vec<LightPatch>>> {
+        let Some(l) = self.method.light_patches() else {
             return Ok(None);
         };
-        let mut patches = readback::read_chosen_patches(self.gpu, b)?;
+        let mut patches = readback::read_light_patches(self.gpu, l.buffer)?;
         let mut positions: Vec<[f32; 4]> = patches.iter().map(|p| p.position_area).collect();
         readback::to_world(&mut positions, self.origin);
         for (p, q) in patches.iter_mut().zip(positions) {
@@ -70,8 +61,12 @@ impl Renderer<'_> {
         Ok(Some(patches))
     }
 
-    /// How many light patches Basic ISR chose in the last frame.
-    pub fn isr_chosen_count(&self) -> Result<Option<u32>> {
-        Ok(self.isr_chosen()?.map(|c| c.len() as u32))
+    /// How many light patches the method's source chose in the last frame,
+    /// for a source that chooses them anew every frame.
+    pub fn light_patches_chosen(&self) -> Result<Option<u32>> {
+        match self.method.light_patches() {
+            Some(l) if l.chosen_per_frame => Ok(self.light_patches()?.map(|c| c.len() as u32)),
+            _ => Ok(None),
+        }
     }
 }

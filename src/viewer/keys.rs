@@ -32,7 +32,7 @@ impl Viewer<'_> {
             }
             Key::VplsDown | Key::VplsUp => {
                 let f = if key == Key::VplsUp { 4.0 } else { 0.25 };
-                self.scale(&crate::methods::vpls::VPLS, f, "VPLs")
+                self.scale(&crate::regular_vpls::VPLS, f, "VPLs")
             }
             Key::View => {
                 self.shown = self.shown.next();

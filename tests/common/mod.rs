@@ -133,7 +133,8 @@ pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderS
 /// where the method reads them: `vpls` VPLs, an ISR base of `isr_base`, and
 /// reference chunks of `chunk` pixel-VPLs per submission.
 pub fn small_params(mut s: RenderSettings, vpls: u32, isr_base: u32, chunk: u64) -> RenderSettings {
-    use isr::methods::{isr::BASE, reference::CHUNK, vpls::VPLS};
+    use isr::methods::{isr::BASE, reference::CHUNK};
+    use isr::regular_vpls::VPLS;
     let method = isr::methods::find(s.method).expect("a registered method");
     for p in isr::methods::params_of(method) {
         match p.name() {

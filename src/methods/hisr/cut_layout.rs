@@ -1,10 +1,10 @@
-//! The layout of HISR's cut buffer (`shaders/shared.glsl`, `HisrCutHeader`):
+//! The layout of HISR's cut buffer (`shaders/hisr/hisr.glsl`, `HisrCutHeader`):
 //! the tile cuts' counts and entries and, with shared visibility, the
 //! tiles' corner and further points' visibilities and march bits; what
 //! `CutPass` allocates and the method's memory states.
 
+use super::gpu::{HisrCutHeader, HISR_CUT_LEVELS};
 use super::{shares_visibility, SHARED_REFINE, TILE_LEVEL};
-use crate::gpu_types::{HisrCutHeader, HISR_CUT_LEVELS};
 use crate::settings::RenderSettings;
 
 /// The most entries a tile's cut holds, per chained level (finest first). All
@@ -25,7 +25,7 @@ const CUT_BUFFER_BUDGET: u64 = 64 << 20;
 /// about 760x760 on), every capacity scales down further.
 const CUT_BUFFER_LIMIT: u64 = 1 << 27;
 
-/// The cut buffer's header for `s` (`shaders/shared.glsl`): chained level c
+/// The cut buffer's header for `s` (`shaders/hisr/hisr.glsl`): chained level c
 /// has tiles of 2^(K + c) pixels a side; each level's counts, then each
 /// level's entries, `capacity` per tile; with shared visibility, then a word
 /// per finest tile and slot of every level and a bit per slot, and with

@@ -1,34 +1,28 @@
 //! Method `hisr` (Hierarchical image-space radiosity, docs/algorithm.md
 //! section 4): every eye-space patch traverses the RSM quadtree itself,
 //! subdividing light patches whose contribution could exceed tau. The
-//! traversal is in `shaders/multires/gather.frag` (`traverse`, with the derivation of
-//! the bound) and reads the quadtree packed into one buffer by the pass
-//! below, starting from its eye-space tile's shared cut (`hisr-cut`); this
-//! module declares the method and its parameters, and makes its passes.
+//! traversal is in `shaders/hisr/gather.frag` (`traverse`, with the
+//! derivation of the bound) and reads the quadtree packed into one buffer
+//! by the light-space source (`source`: pass `light-tree-pack`), starting
+//! from its eye-space tile's shared cut (`cut`: pass `hisr-cut`); this
+//! module declares the method, its parameters and the specialization
+//! constants that carry them to `shaders/hisr/`.
 
-use super::gather::{GatherPass, LightPatches};
-use super::multires_method::{
-    written_for_gather, LightSpacePass, MultiresMethod, PatchList, PatchListPass,
-};
 use super::{Descriptor, IndirectMethod};
-use crate::frame::{FrameContext, Setup};
-use crate::gpu_types::{
-    HisrCutHeader, LightPatch, RunUniforms, HISR_CUT_LEVELS, HISR_TAU_ABSOLUTE, HISR_TAU_RELATIVE,
-};
-use crate::multires;
-use crate::passes::{rsm_tree, ComputePass, INDIRECT_COMPUTE};
+use crate::frame::Setup;
+use crate::gpu_types::LightPatch;
+use crate::multires::{self, MultiresMethod};
+use crate::passes::rsm_tree;
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Method, Params, RenderSettings};
-use crate::vk::barrier;
-use crate::vk::pipeline::Binding;
-use crate::vk::profiler::Profiler;
-use crate::vk::Buffer;
-use anyhow::{anyhow, bail, Result};
+use crate::vk::pipeline::Spec;
+use anyhow::{bail, Result};
 
+mod cut;
 mod cut_layout;
-use ash::vk;
+pub mod gpu;
+mod source;
 pub use cut_layout::{cut_bytes, cut_layout};
-use gpu_allocator::MemoryLocation;
 
 pub const KEY: Method = Method::new("hisr");
 
@@ -179,10 +173,26 @@ pub fn shares_visibility(s: &RenderSettings) -> bool {
     crate::visibility::uses_voxels(s) && TILE_LEVEL.get(s) > 0 && SHARED_VISIBILITY.get(s)
 }
 
+/// The specialization constants of every shader that includes
+/// `shaders/hisr/hisr.glsl`: the run's tau, what it bounds, T (for the
+/// absolute tau) and the traversal's start and max depths.
+pub fn constants(s: &RenderSettings) -> [Spec; 5] {
+    [
+        Spec::float("HISR_TAU", TAU.get(s)),
+        Spec::bool("HISR_TAU_ABSOLUTE", TAU_MODE.get(s) == TauMode::Absolute),
+        Spec::float(
+            "HISR_THRESHOLD",
+            subdivision_threshold(TAU.get(s), s.rsm_resolution),
+        ),
+        Spec::int("HISR_START_DEPTH", START_LEVEL.get(s) as i32),
+        Spec::int("HISR_MAX_DEPTH", MAX_DEPTH.get(s) as i32),
+    ]
+}
+
 /// T at the finest level for `tau` given as a fraction of the light's peak
 /// intensity I: T = 2 (I - tau I) / (3 tau I R^2) = 2 (1 - tau) / (3 tau R^2)
-/// (`shaders/multires/gather.frag` derives the test; this is the one place T is
-/// computed, for the run uniforms).
+/// (`shaders/hisr/gather.frag` derives the test; this is the one place T is
+/// computed, for `HISR_THRESHOLD`).
 pub fn subdivision_threshold(tau: f32, rsm_resolution: u32) -> f32 {
     let r2 = rsm_resolution as f64 * rsm_resolution as f64;
     (2.0 * (1.0 - tau as f64) / (3.0 * tau as f64 * r2)) as f32
@@ -224,16 +234,6 @@ impl Descriptor for HisrMethod {
         let node = std::mem::size_of::<LightPatch>() as u64;
         packed_nodes(s) * node + cut_bytes(s)
     }
-    fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        u.hisr_threshold = subdivision_threshold(TAU.get(s), s.rsm_resolution);
-        u.hisr_tau = TAU.get(s);
-        u.hisr_tau_mode = match TAU_MODE.get(s) {
-            TauMode::Relative => HISR_TAU_RELATIVE,
-            TauMode::Absolute => HISR_TAU_ABSOLUTE,
-        };
-        u.hisr_start_depth = START_LEVEL.get(s) as i32;
-        u.hisr_max_depth = MAX_DEPTH.get(s) as i32;
-    }
     fn sweep(&self, rsm: u32, quick: bool) -> Vec<Params> {
         sweep(rsm, quick)
     }
@@ -248,8 +248,18 @@ impl Descriptor for HisrMethod {
         }
         l
     }
+    fn warnings(&self, s: &RenderSettings) -> Vec<String> {
+        unused_sharing_warning(s).into_iter().collect()
+    }
+    fn main_param(&self) -> Option<&'static dyn AnyParam> {
+        Some(&TAU)
+    }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
-        Ok(Box::new(make(setup)?))
+        let source = source::HisrSource::new(setup)?;
+        Ok(Box::new(MultiresMethod::gathering(
+            setup,
+            Box::new(source),
+        )?))
     }
 }
 
@@ -307,40 +317,6 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     v
 }
 
-/// Method `hisr`: pass `light-tree-pack` (`shaders/hisr/tree_pack.comp`)
-/// copies the RSM quadtree's nodes down to the max depth into one buffer, root
-/// first; with tiles (`--hisr-tile-level`), pass `hisr-cut` finds each
-/// eye-space tile's shared cut; then the gather traverses per fragment.
-fn make(setup: &Setup) -> Result<MultiresMethod> {
-    let nodes = packed_nodes(setup.settings);
-    // One invocation per node: 2^max_depth wide, enough rows for every node.
-    let width = 1u64 << MAX_DEPTH.get(setup.settings);
-    let extent = vk::Extent2D {
-        width: width as u32,
-        height: nodes.div_ceil(width) as u32,
-    };
-    let pack = PatchListPass::new(
-        setup,
-        PatchList::PackedTree,
-        ("light-tree-pack", "hisr/tree_pack.comp", "LightTree"),
-        nodes,
-        extent,
-    )?;
-    let cut = match TILE_LEVEL.get(setup.settings) {
-        0 => None,
-        _ => Some(CutPass::new(setup, pack.patch_buffer())?),
-    };
-    let source = match cut {
-        Some(_) => LightPatches::TiledTraversal,
-        None => LightPatches::Traversal,
-    };
-    let light = HisrLightPass { pack, cut };
-    MultiresMethod::new(setup, Some(Box::new(light)), move |setup, m, light| {
-        let light = light.ok_or_else(|| anyhow!("hisr gathers from its packed tree"))?;
-        Ok(Box::new(GatherPass::new(setup, m, source, light)?))
-    })
-}
-
 /// Nodes in HISR's packed tree: every depth from the root down to the max
 /// depth, `(4^(D+1) - 1) / 3`. Deeper nodes are never read (nodes at the max
 /// depth never split), so they are not packed: at RSM 1024 and depth 6 that is
@@ -348,178 +324,6 @@ fn make(setup: &Setup) -> Result<MultiresMethod> {
 pub fn packed_nodes(s: &RenderSettings) -> u64 {
     let side = 1u64 << MAX_DEPTH.get(s);
     (4 * side * side - 1) / 3
-}
-
-/// HISR's light-space passes: the packing, then (with tiles) the cut.
-struct HisrLightPass {
-    pack: PatchListPass,
-    cut: Option<CutPass>,
-}
-
-impl LightSpacePass for HisrLightPass {
-    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
-        self.pack.record(ctx, profiler);
-        if let Some(cut) = &self.cut {
-            cut.record(ctx, profiler);
-        }
-    }
-
-    fn patch_buffer(&self) -> &Buffer {
-        self.pack.patch_buffer()
-    }
-
-    fn packed_tree(&self) -> Option<&Buffer> {
-        self.pack.packed_tree()
-    }
-
-    fn tile_cuts(&self) -> Option<&Buffer> {
-        self.cut.as_ref().map(|c| &c.buffer)
-    }
-
-    fn shared_visibility_refine(&self) -> Option<f32> {
-        self.cut
-            .as_ref()
-            .and_then(|c| c.visibility.as_ref().map(|_| c.refine))
-    }
-}
-
-/// Pass `hisr-cut` (`shaders/hisr/cut.comp`, docs/algorithm.md section 4.4):
-/// one dispatch for the finest tiles' boxes of G-buffer positions, then one
-/// per chained level, coarsest first, one invocation per eye-space tile.
-/// Reads the G-buffer positions, the packed tree, the boxes and the coarser
-/// level's cuts; writes the cut buffer (barriers in `record`).
-struct CutPass {
-    boxes: ComputePass,
-    pass: ComputePass,
-    /// Pass `hisr-visibility` (`shaders/hisr/visibility.comp`), with shared
-    /// visibility.
-    visibility: Option<ComputePass>,
-    /// `--hisr-shared-refine`, for the gather.
-    refine: f32,
-    buffer: Buffer,
-    header: HisrCutHeader,
-}
-
-impl CutPass {
-    fn new(setup: &Setup, tree: &Buffer) -> Result<Self> {
-        let header = cut_layout(setup.settings);
-        let buffer = Buffer::new(
-            setup.gpu,
-            "hisr-cut",
-            cut_bytes(setup.settings),
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::GpuOnly,
-        )?;
-        let (t, s) = (setup.targets, setup.samplers);
-        let bindings = vec![
-            Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
-            Binding::storage("LightTree", tree),
-            Binding::storage("HisrCut", &buffer),
-        ];
-        let push_bytes = std::mem::size_of::<HisrCutHeader>() as u32 + 4;
-        // Specialisation constant 0 (BOXES): the boxes' dispatch or the cuts'.
-        let pass = |boxes: bool| {
-            ComputePass::new(
-                setup,
-                "hisr-cut",
-                "hisr/cut.comp",
-                std::slice::from_ref(&bindings),
-                push_bytes,
-                &[crate::vk::pipeline::Spec::bool("BOXES", boxes)],
-            )
-        };
-        let visibility = match shares_visibility(setup.settings) {
-            true => Some(ComputePass::new(
-                setup,
-                "hisr-visibility",
-                "hisr/visibility.comp",
-                &[vec![
-                    Binding::sampled("gbuffer_position", t.gbuffer_position.view, s.nearest),
-                    Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, s.nearest),
-                    Binding::storage("LightTree", tree),
-                    Binding::storage("HisrCut", &buffer),
-                ]],
-                0,
-                // REFINE_SPREAD: which entries get their march bit; the
-                // grid's layout and march.
-                &[
-                    crate::vk::pipeline::Spec::float(
-                        "REFINE_SPREAD",
-                        SHARED_REFINE.get(setup.settings),
-                    ),
-                    crate::voxel_grid::specialization(setup.settings),
-                ],
-            )?),
-            false => None,
-        };
-        Ok(Self {
-            boxes: pass(true)?,
-            pass: pass(false)?,
-            visibility,
-            refine: SHARED_REFINE.get(setup.settings),
-            buffer,
-            header,
-        })
-    }
-
-    fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
-        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
-        let readers = vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COPY;
-        profiler.pass(gpu, cmd, "hisr-cut", INDIRECT_COMPUTE, || {
-            // The packed tree, just written, is read here; the previous
-            // gather (of this frame's previous light view or the previous
-            // frame) and readback read the cuts before they are overwritten.
-            barrier::memory(
-                gpu,
-                cmd,
-                vk::PipelineStageFlags2::COMPUTE_SHADER | readers,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
-            let push = |c: usize| {
-                let mut push = bytemuck::bytes_of(&self.header).to_vec();
-                push.extend_from_slice(&(c as i32).to_ne_bytes());
-                push
-            };
-            let [tx, ty, ..] = self.header.tiles[0];
-            let finest = vk::Extent2D {
-                width: tx,
-                height: ty,
-            };
-            self.boxes.dispatch(ctx, 0, &push(0), finest);
-            for c in (0..HISR_CUT_LEVELS).rev() {
-                // Level c reads the boxes and level c + 1's cuts.
-                barrier::compute_to_compute(gpu, cmd);
-                let push = push(c);
-                // One invocation per tile.
-                let [tx, ty, ..] = self.header.tiles[c];
-                let extent = vk::Extent2D {
-                    width: tx,
-                    height: ty,
-                };
-                self.pass.dispatch(ctx, 0, &push, extent);
-            }
-            written_for_gather(ctx);
-        });
-        if let Some(visibility) = &self.visibility {
-            profiler.pass(gpu, cmd, "hisr-visibility", INDIRECT_COMPUTE, || {
-                // The cuts just written are read here (and the previous
-                // gather's reads of the visibilities were ordered before
-                // hisr-cut's first dispatch).
-                barrier::compute_to_compute(gpu, cmd);
-                // One workgroup of 8x8 per finest tile (frame::check
-                // holds the tiles a side within the device's workgroups).
-                let [tx, ty, ..] = self.header.tiles[0];
-                let extent = vk::Extent2D {
-                    width: 8 * tx,
-                    height: 8 * ty,
-                };
-                visibility.dispatch(ctx, 0, &[], extent);
-                written_for_gather(ctx);
-            });
-        }
-    }
 }
 
 #[cfg(test)]

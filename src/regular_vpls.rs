@@ -1,15 +1,21 @@
-//! The N regular VPLs that `multires-gather`, `rsm-gather`, the splats and
-//! (with every RSM texel) `reference` read (docs/algorithm.md section 4):
-//! level `log2(R / sqrt(N))` of the RSM quadtree, each VPL its patch's
-//! summed flux and area at its mean position and normal, or its centre
-//! texel (`--vpl-sampling point`). Their parameters, the one function that
-//! derives their side and level ([`RegularVpls`]), its uniforms, and the
-//! bench's VPL-count sweep, shared by those methods.
+//! The N regular VPLs that the methods with a fixed VPL budget read
+//! (docs/algorithm.md section 4.1), each method saying so with
+//! `Descriptor::reads_regular_vpls`: level `log2(R / sqrt(N))` of the RSM
+//! quadtree, each VPL its patch's summed flux and area at its mean position
+//! and normal, or its centre texel (`--vpl-sampling point`). Their
+//! parameters, the one function that derives their side and level
+//! ([`RegularVpls`]), the specialization constants that carry them to
+//! `shaders/regular_vpls/regular_vpls.glsl`, the light-space source that
+//! lists them for the multiresolution gather ([`RegularVpls::list`]), and
+//! the bench's VPL-count sweep.
 
-use crate::gpu_types::{self, RunUniforms};
+use crate::frame::Setup;
+use crate::multires::PatchList;
 use crate::settings::params::{AnyParam, Choices, DefaultValue, Param, Range};
 use crate::settings::{Params, RenderSettings};
+use crate::vk::pipeline::Spec;
 use anyhow::{bail, Result};
+use ash::vk;
 
 /// The largest `--vpls`: every texel of a 4096 x 4096 RSM.
 const MAX_VPLS: f64 = 4096.0 * 4096.0;
@@ -61,7 +67,7 @@ pub const PARAMS: &[&dyn AnyParam] =
 
 /// The regular VPLs of a run: how many, how many per side, and the RSM
 /// quadtree level they are. The host's draw counts and dispatch sizes and
-/// the shaders' `vpl_side` and `vpl_level` all come from here.
+/// the shaders' `VPL_SIDE` and `VPL_LEVEL` all come from here.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RegularVpls {
     pub count: u32,
@@ -86,13 +92,35 @@ impl RegularVpls {
         Self { count, side, level }
     }
 
-    /// Their fields of the run uniforms (and `--vpl-sampling`'s flag).
-    pub fn write_uniforms(&self, s: &RenderSettings, u: &mut RunUniforms) {
-        u.vpl_level = self.level as i32;
-        u.vpl_side = self.side as i32;
-        if VPL_SAMPLING.get(s) == VplSampling::Point {
-            u.hierarchy_flags |= gpu_types::HIERARCHY_POINT_VPLS;
-        }
+    /// The specialization constants of every shader that includes
+    /// `shaders/regular_vpls/regular_vpls.glsl`: their level and side, and
+    /// `--vpl-sampling`.
+    pub fn specialization(&self, s: &RenderSettings) -> [Spec; 3] {
+        [
+            Spec::int("VPL_LEVEL", self.level as i32),
+            Spec::int("VPL_SIDE", self.side as i32),
+            Spec::bool("POINT_VPLS", VPL_SAMPLING.get(s) == VplSampling::Point),
+        ]
+    }
+
+    /// The light-space source that writes them into one list once per
+    /// frame, VPL j at entry j (pass `vpl-list`,
+    /// `shaders/regular_vpls/list.comp`), for the multiresolution gather.
+    pub fn list(&self, setup: &Setup) -> Result<PatchList> {
+        PatchList::new(
+            setup,
+            (
+                "vpl-list",
+                "regular_vpls/list.comp",
+                &self.specialization(setup.settings),
+            ),
+            false,
+            self.count as u64,
+            vk::Extent2D {
+                width: self.side,
+                height: self.side,
+            },
+        )
     }
 }
 

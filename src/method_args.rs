@@ -1,12 +1,12 @@
-//! Every registered parameter as a command-line option: `--NAME VALUE`, one
-//! per parameter of any method (`all_params`), with its help, default and
-//! range in `--help`. `isr render`, `isr view` and `isr bench` flatten
+//! Every registered method parameter as a command-line option: `--NAME
+//! VALUE`, one per parameter of any method (`methods::all_params`), with its
+//! help, default and range in `--help`. `isr render`, `isr view` and `isr bench` flatten
 //! [`ParamArgs`] into their arguments (`#[command(flatten)]`), so a
 //! parameter declared in its method's module reaches every command without
 //! a line of CLI code. Values are parsed for their type here and checked
 //! against their ranges with the other settings (`methods::check`).
 
-use super::{all_params, params_of, REGISTRY};
+use crate::methods::{all_params, params_of, REGISTRY};
 use crate::settings::params::AnyParam;
 use crate::settings::{Params, Value};
 

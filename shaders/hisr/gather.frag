@@ -1,83 +1,33 @@
 #version 460
-// Stenciled gathering (docs/algorithm.md section 3, step 6): one draw over every
-// layer of the illumination buffer; the stencil test (EQUAL 1) runs before the
-// shader, so only patches are shaded. Each patch sums C_{j->i} / rho_i over its
-// light patches at its mean position and normal. Which light patches, is the
-// method (docs/algorithm.md section 4), chosen by LIGHT_PATCHES:
-//   0  a list: the N regular VPLs (regular_vpls/list.comp, multires-gather) or the
-//      patches Basic ISR chose this frame (isr/select.comp, isr)
-//   1  a per-fragment traversal of the packed quadtree (hisr/tree_pack.comp, hisr)
-//   2  the same traversal, started from the fragment's tile's cut
-//      (hisr/cut.comp, hisr with --hisr-tile-level K > 0)
-// With the stencil off (a measurement baseline) every texel is shaded and
-// non-patches are masked afterwards.
+// HISR's gather (docs/algorithm.md section 4.3): every eye-space patch
+// traverses the packed light tree itself (hisr/tree_pack.comp), from the
+// roots, or with tiles (TILED, --hisr-tile-level K > 0) from its tile's
+// shared cut (hisr/cut.comp). The frame of the pass, and add_patch, are
+// multires/gather.glsl's.
 #extension GL_GOOGLE_include_directive : require
-#include "frame.glsl"
-#include "light_types.glsl"
-#include "vpl.glsl"
+#include "multires/gather.glsl"
 #include "hisr/hisr.glsl"
 #include "hisr/tile_points.glsl"
 
-layout(early_fragment_tests) in;
-
-layout(constant_id = 14) const int LIGHT_PATCHES = 0;
-// HISR with tiles and --visibility voxels: the tiles' shared visibility
+// Whether the traversal starts from the tiles' cuts (hisr/cut.comp).
+layout(constant_id = 33) const bool TILED = false;
+// With tiles and --visibility voxels: the tiles' shared visibility
 // (hisr/visibility.comp, --hisr-shared-visibility).
 layout(constant_id = 30) const bool SHARED_VISIBILITY = false;
 // --hisr-shared-refine: the corners' spread past which a receiver marches
 // a patch itself (next_entry; hisr/visibility.comp sets the bits); 1 never does.
 layout(constant_id = 31) const float REFINE_SPREAD = 1.0;
 
-layout(set = 1, binding = 0) uniform sampler2D geo_mean;    // levels 1..L (multires/geo_levels.glsl)
-layout(set = 1, binding = 1) uniform sampler2D geo_normal;  // levels 1..L
-layout(set = 1, binding = 2) uniform usampler2D geo_flags;  // levels 1..L
-// The regular VPLs, Basic ISR's chosen list, or HISR's packed quadtree.
-layout(set = 1, binding = 3, std430) readonly buffer ChosenPatches {
-    uint patch_count;
+layout(set = 1, binding = GATHER_SOURCE_BINDING, std430) readonly buffer LightTree {
+    uint node_count;
     uint pad0, pad1, pad2;
-    LightPatch patches[];
+    LightPatch nodes[];  // the packed tree, root first (hisr/tree_pack.comp)
 };
-layout(set = 1, binding = 4) uniform sampler2D gbuffer_position;  // level 0
-layout(set = 1, binding = 5) uniform sampler2D gbuffer_normal;
-// HISR's per-tile cuts (read only when LIGHT_PATCHES == 2; other methods bind
-// ChosenPatches' buffer here).
-layout(set = 1, binding = 6, std430) readonly buffer HisrCut {
+// The tiles' cuts (hisr/cut.comp; read only when TILED).
+layout(set = 1, binding = GATHER_SOURCE_BINDING + 1, std430) readonly buffer HisrCut {
     HisrCutHeader cut_header;
-    uint cut[];  // per level counts, then per level entries (shared.glsl)
+    uint cut[];  // per level counts, then per level entries (hisr/hisr.glsl)
 };
-#define GEO_FLAGS
-#include "multires/geo_levels.glsl"
-
-layout(location = 0) flat in int level;  // the layer (multires/layered.vert)
-
-layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2); a: 1 = this texel is a patch
-layout(location = 1) out float out_evaluations; // light patches evaluated (a count, R32F so splats can add)
-
-vec3 e = vec3(0.0);
-uint evaluations = 0u;
-
-// level: patch_level of the patch (patch_irradiance).
-// march: whether to march (patch_irradiance) or apply visibility v. Callers
-// pass a constant: the driver then drops the march where it is false, whose
-// mere presence in the traversal's loop cost lavapipe as much as the rest of
-// the gather.
-void add_patch(vec3 xi, vec3 ni, vec4 pos, vec4 nrm, vec3 flux, int level, bool march, float v) {
-    if (!march) {
-        e += v * patch_unshadowed(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
-    } else {
-        e += patch_irradiance(xi, ni, pos.xyz, nrm.xyz, flux, pos.w, level);
-    }
-    evaluations += 1u;
-}
-
-void patch_list(vec3 xi, vec3 ni) {
-    for (uint j = 0u; j < patch_count; ++j) {
-        LightPatch lp = patches[j];
-        if (lp.position_area.w <= 0.0) continue;  // an empty regular VPL
-        // A list's normal.w is the patch's patch_level (regular_vpls/list.comp, isr/select.comp).
-        add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb, int(lp.normal.w), true, 1.0);
-    }
-}
 
 // Hierarchical ISR (docs/algorithm.md section 4.3): subdivide patch j while
 // its form factor seen from this receiver exceeds tau (relative tau, the
@@ -93,7 +43,7 @@ void patch_list(vec3 xi, vec3 ni) {
 // gives its form: C <= 2 I |V_j|^2 / (3 R^2 |V_ij|^2 + 2 |V_j|^2). Requiring
 // it to exceed tau:
 //   subdivide j  iff  |V_ij|^2 <= T |V_j|^2,  T = 2 (I - tau) / (3 tau R^2),
-// constant per run (run.hisr_threshold; `--tau` is tau / I, so the host
+// constant per run (HISR_THRESHOLD; `--tau` is tau / I, so the host
 // computes T = 2 (1 - tau) / (3 tau R^2), in the one place it is evaluated).
 // The per-level factor: a patch k levels above the finest stands
 // for 4^k texels, i.e. one texel of an (R / 2^k)^2 RSM, so R^2 becomes
@@ -113,13 +63,13 @@ void patch_list(vec3 xi, vec3 ni) {
 // (a node's children are (2x + i, 2y + j) one depth down), so the next node
 // follows from its coordinates. No per-fragment array: on GPUs a stack spills to memory, and CPU
 // drivers turn each indexed access into selects over all its entries.
-// The nodes come from the packed tree (hisr/tree_pack.comp, bound as
-// ChosenPatches; node_index in hisr/hisr.glsl).
+// The nodes come from the packed tree (hisr/tree_pack.comp; node_index in
+// hisr/hisr.glsl).
 // march, v: as add_patch's, for every patch of the walk.
 void traverse_from(vec3 xi, vec3 ni, ivec3 root, bool march, float v) {
     ivec3 node = root;  // xy: patch coordinates; z: depth (2^z x 2^z patches at that depth)
     for (;;) {
-        LightPatch lp = patches[node_index(node)];
+        LightPatch lp = nodes[node_index(node)];
         // Empty nodes (saw nothing) are skipped before the split test, although
         // their reach (-1) never splits: with the test first, lavapipe shaded the
         // fragments of silhouette columns as if no node split (the tile-cut test
@@ -140,7 +90,7 @@ void traverse_from(vec3 xi, vec3 ni, ivec3 root, bool march, float v) {
 
 // From the 2^s x 2^s patches of the start depth.
 void traverse(vec3 xi, vec3 ni) {
-    int start = run.hisr_start_depth;
+    int start = HISR_START_DEPTH;
     int side = 1 << start;
     for (int s = 0; s < side * side; ++s) traverse_from(xi, ni, ivec3(s % side, s / side, start), true, 1.0);
 }
@@ -277,7 +227,7 @@ void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
         uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
         for (uint i = next_entry(sv, slot, false, 0u, n, false); i < n; i = next_entry(sv, slot, false, i + 1u, n, false)) {
             uint index = cut[base + i];  // a packed index
-            LightPatch lp = patches[index];
+            LightPatch lp = nodes[index];
             float v = shared_value(sv, slot + i);
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
                       patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), false, v);
@@ -285,7 +235,7 @@ void traverse_cut_shared(vec3 xi, vec3 ni, ivec2 p, uint t0, uint counts) {
         if (REFINE_SPREAD < 1.0) {
             for (uint i = next_entry(sv, slot, false, 0u, n, true); i < n; i = next_entry(sv, slot, false, i + 1u, n, true)) {
                 uint index = cut[base + i];
-                LightPatch lp = patches[index];
+                LightPatch lp = nodes[index];
                 add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
                           patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), true, 1.0);
             }
@@ -330,7 +280,7 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
         uint base = cut_header.entries[1 + c] + t * cut_header.capacity[c];
         for (uint i = 0u; i < n; ++i) {
             uint index = cut[base + i];  // a packed index
-            LightPatch lp = patches[index];
+            LightPatch lp = nodes[index];
             add_patch(xi, ni, lp.position_area, lp.normal, lp.flux.rgb,
                       patch_level(run.rsm_top_level - node_depth(index), lp.normal.w), true, 1.0);
         }
@@ -340,23 +290,10 @@ void traverse_cut(vec3 xi, vec3 ni, ivec2 p) {
     for (uint i = 0u; i < counts >> 16; ++i) traverse_from(xi, ni, cut_node(cut[last - i]), true, 1.0);
 }
 
-void main() {
-    ivec2 p = ivec2(gl_FragCoord.xy);
-    vec3 xi = geo_mean_at(p, level).xyz;
-    vec3 ni = geo_normal_at(p, level).xyz;
-    if (LIGHT_PATCHES == 0) {
-        patch_list(xi, ni);
-    } else if (LIGHT_PATCHES == 1) {
-        traverse(xi, ni);
-    } else {
+void gather_patches(vec3 xi, vec3 ni, ivec2 p) {
+    if (TILED) {
         traverse_cut(xi, ni, p);
+    } else {
+        traverse(xi, ni);
     }
-    float is = 1.0;
-    if ((run.hierarchy_flags & HIERARCHY_STENCIL_OFF) != 0 && !is_patch(level, run.levels, p)) {
-        is = 0.0;
-        e = vec3(0.0);
-        evaluations = 0u;
-    }
-    out_irradiance = vec4(e, is);
-    out_evaluations = float(evaluations);
 }
