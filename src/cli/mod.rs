@@ -326,7 +326,7 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(w) = unused_grid_warning(&settings, uses_voxels(&settings)) {
         eprintln!("{w}");
     }
-    if let Some(w) = crate::methods::hisr::unused_sharing_warning(&settings) {
+    for w in descriptor.warnings(&settings) {
         eprintln!("{w}");
     }
     let exact =

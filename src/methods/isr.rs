@@ -82,6 +82,9 @@ impl Descriptor for IsrMethod {
     fn label(&self, s: &RenderSettings) -> String {
         format!("base {}", BASE.get(s))
     }
+    fn main_param(&self) -> Option<&'static dyn AnyParam> {
+        Some(&BASE)
+    }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
         // At most one chosen patch per base texel, one invocation each.
         let base = base_level(setup.settings);

@@ -367,6 +367,10 @@ pub trait AnyParam: Sync {
     }
     /// Fails with a message naming the option when `s`'s value is out of range.
     fn check(&self, s: &RenderSettings) -> Result<()>;
+    /// The value `s` holds times `factor`, kept inside the range (a step
+    /// toward an open bound goes halfway to it), or `None` for a parameter
+    /// that is not a number (the viewer's keys scale a method's main knob).
+    fn scaled_in(&self, s: &RenderSettings, factor: f64) -> Option<Value>;
 }
 
 impl<T: ParamType + Sync> AnyParam for Param<T> {
@@ -399,6 +403,16 @@ impl<T: ParamType + Sync> AnyParam for Param<T> {
     }
     fn is_default_in(&self, s: &RenderSettings) -> bool {
         self.get(s) == self.default_in(s)
+    }
+    fn scaled_in(&self, s: &RenderSettings, factor: f64) -> Option<Value> {
+        let v = self.get(s);
+        let old = v.number()?;
+        let new = self.range.clamp_from(old, old * factor);
+        match v.to_value() {
+            Value::Real(_) => Some(Value::Real(new as f32)),
+            Value::Count(_) => Some(Value::Count(new.round().max(0.0) as u64)),
+            Value::Switch(_) | Value::Choice(_) => None,
+        }
     }
     fn check(&self, s: &RenderSettings) -> Result<()> {
         if let Some(v) = s.params.get(self.name) {

@@ -7,8 +7,8 @@
 use super::controls::Key;
 use super::overlay::PassAverages;
 use super::Viewer;
-use crate::settings::{Param, ParamType, RenderSettings};
-use anyhow::Result;
+use crate::settings::RenderSettings;
+use anyhow::{bail, Result};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -26,14 +26,7 @@ impl Viewer<'_> {
                 s.method = self.methods[i];
                 self.switch(s, "method")
             }
-            Key::TauDown | Key::TauUp => {
-                let f = if key == Key::TauUp { 2.0 } else { 0.5 };
-                self.scale(&crate::methods::hisr::TAU, f, "tau")
-            }
-            Key::VplsDown | Key::VplsUp => {
-                let f = if key == Key::VplsUp { 4.0 } else { 0.25 };
-                self.scale(&crate::regular_vpls::VPLS, f, "VPLs")
-            }
+            Key::KnobDown | Key::KnobUp => self.scale_knob(key == Key::KnobUp),
             Key::View => {
                 self.shown = self.shown.next();
                 self.status = format!("view: {}", self.shown.name());
@@ -76,14 +69,22 @@ impl Viewer<'_> {
         }
     }
 
-    /// Multiplies parameter `p` by `factor`, kept inside its range (a step
-    /// toward an open bound goes halfway to it), and switches to it.
-    fn scale<T: Scalable>(&mut self, p: &Param<T>, factor: f64, what: &str) -> Result<()> {
+    /// Multiplies the method's main knob (`Descriptor::main_param`) by its
+    /// step, 2 or the power its values take (4 for the VPL count), or
+    /// divides it, kept inside its range, and switches to it.
+    fn scale_knob(&mut self, up: bool) -> Result<()> {
         let mut s = self.renderer.settings.clone();
-        let old = p.get(&s);
-        let new = p.clamp_from(old, T::from_f64(old.to_f64() * factor));
-        p.set(&mut s, T::from_f64(new));
-        self.switch(s, what)
+        let d = crate::methods::find(s.method)?;
+        let Some(p) = d.main_param() else {
+            bail!("method {} has no main knob to scale", s.method);
+        };
+        let step = p.range().power_of.unwrap_or(2) as f64;
+        let factor = if up { step } else { 1.0 / step };
+        let Some(v) = p.scaled_in(&s, factor) else {
+            bail!("--{} is not a number the keys can scale", p.name());
+        };
+        s.params.insert(p.name(), v);
+        self.switch(s, p.name())
     }
 
     /// Switches the method or its parameters: only the method's resources
@@ -97,29 +98,5 @@ impl Viewer<'_> {
         );
         self.stats = PassAverages::default();
         Ok(())
-    }
-}
-
-/// A numeric parameter the viewer's keys scale.
-trait Scalable: ParamType {
-    fn to_f64(self) -> f64;
-    fn from_f64(x: f64) -> Self;
-}
-
-impl Scalable for f32 {
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-    fn from_f64(x: f64) -> Self {
-        x as f32
-    }
-}
-
-impl Scalable for u32 {
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-    fn from_f64(x: f64) -> Self {
-        x.round().clamp(0.0, u32::MAX as f64) as u32
     }
 }

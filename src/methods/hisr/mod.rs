@@ -157,7 +157,7 @@ pub const PARAMS: &[&dyn AnyParam] = &[
 /// The warning for `--hisr-shared-visibility on` or `--hisr-shared-refine`
 /// given where they cannot act: without the grid or without tiles (most
 /// likely a forgotten `--visibility voxels`).
-pub fn unused_sharing_warning(s: &RenderSettings) -> Option<String> {
+fn unused_sharing_warning(s: &RenderSettings) -> Option<String> {
     let given =
         (SHARED_VISIBILITY.is_set_in(s) && SHARED_VISIBILITY.get(s)) || SHARED_REFINE.is_set_in(s);
     (given && !shares_visibility(s)).then(|| {

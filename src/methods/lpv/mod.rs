@@ -165,6 +165,10 @@ impl Descriptor for LpvMethod {
         }
         label
     }
+    /// Propagation steps: how far light spreads, and what it costs.
+    fn main_param(&self) -> Option<&'static dyn AnyParam> {
+        Some(&ITERATIONS)
+    }
     fn create(&self, setup: &Setup) -> Result<Box<dyn IndirectMethod>> {
         Ok(Box::new(Lpv::new(setup)?))
     }
