@@ -216,14 +216,16 @@ where
     for (scene, panel) in scenes.iter().zip(panels.iter()) {
         let pts: Vec<&Row> = rows
             .iter()
-            .filter(|row| &row.scene == scene && row.method != "reference")
+            .filter(|row| &row.scene == scene && row.method != crate::methods::REFERENCE.name())
             .filter(|row| {
                 row.indirect_ms.is_some_and(|v| v > 0.0) && y(row).is_some_and(|v| v > 0.0)
             })
             .collect();
         let floors: Vec<(String, f64)> = rows
             .iter()
-            .filter(|row| reference && &row.scene == scene && row.method == "reference")
+            .filter(|row| {
+                reference && &row.scene == scene && row.method == crate::methods::REFERENCE.name()
+            })
             .filter_map(|row| {
                 let name = super::visibility::series_name("dense reference", &row.visibility);
                 Some((name, y(row).filter(|v| *v > 0.0)?))
@@ -296,7 +298,7 @@ where
 fn series_in(rows: &[Row]) -> Vec<Series<'_>> {
     let mut out: Vec<Series> = vec![];
     for r in rows {
-        if r.method != "reference" && !out.contains(&Series::of(r)) {
+        if r.method != crate::methods::REFERENCE.name() && !out.contains(&Series::of(r)) {
             out.push(Series::of(r));
         }
     }
@@ -459,7 +461,7 @@ where
         .map_err(|e| anyhow!("{e}"))?;
     let panels = root.split_evenly(legend_grid(scenes.len()));
     // The passes of the bars (the references' own are not drawn).
-    let is_bar = |r: &&Row| r.is_default && r.method != "reference";
+    let is_bar = |r: &&Row| r.is_default && r.method != crate::methods::REFERENCE.name();
     let passes: Vec<String> = super::rows::pass_names(rows)
         .into_iter()
         .filter(|p| rows.iter().filter(is_bar).any(|r| r.passes.contains_key(p)))

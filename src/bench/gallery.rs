@@ -38,10 +38,10 @@ pub fn gallery(
     for s in scenes {
         let images = files::images_dir(dir, s);
         for (v, suffix) in visibilities {
-            let reference = super::visibility::series_name("reference", v);
+            let reference = super::visibility::series_name(crate::methods::REFERENCE.name(), v);
             let mut top = vec![(
                 format!("{s}: {reference}"),
-                load(&images.join(files::image("reference", suffix))),
+                load(&images.join(files::image(crate::methods::REFERENCE.name(), suffix))),
             )];
             let mut bottom = vec![("FLIP: black 0, white 1".to_string(), None)];
             for m in methods {

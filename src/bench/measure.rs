@@ -143,7 +143,7 @@ fn reference(
     let ref_row = work.ref_row;
     let images = super::files::images_dir(&plan.out_dir, &spec.name);
     let with_truth = plan.truth_noise.is_some() && work.measures();
-    let name = visibility::series_name("reference", &plan.visibility_label());
+    let name = visibility::series_name(crate::methods::REFERENCE.name(), &plan.visibility_label());
     let mut refs = Vec::with_capacity(plan.frames as usize);
     let mut ref_stats = FrameStats::default();
     let mut model = rows::TruthErrors::default();
@@ -239,7 +239,7 @@ fn points(
     // The allocator's total without any indirect method, to subtract; and
     // without the grid, which is part of what visibility costs a method.
     let baseline = {
-        let none = settings_of(plan, crate::methods::none::KEY);
+        let none = settings_of(plan, crate::methods::DIRECT_ONLY);
         let _none = Renderer::new(gpu, scene, &visibility::with(&none, Visibility::None))?;
         allocated_bytes(gpu)
     };

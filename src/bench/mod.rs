@@ -349,7 +349,7 @@ impl Plan {
 }
 
 const REFERENCE_LABEL: &str = "every RSM texel";
-const REFERENCE: Method = crate::methods::reference::KEY;
+const REFERENCE: Method = crate::methods::REFERENCE;
 
 /// What a finished run returns (the rows of this plan, in order).
 pub struct Outcome {
@@ -374,7 +374,7 @@ fn gallery_images(plan: &Plan, spec: &SceneSpec) -> Vec<PathBuf> {
 /// The gallery image of pass `plan`'s reference: `reference.png`, or with
 /// the grid `reference-voxels.png`.
 fn reference_image(plan: &Plan) -> String {
-    files::image("reference", plan.image_suffix())
+    files::image(crate::methods::REFERENCE.name(), plan.image_suffix())
 }
 
 /// The gallery images of point `c` of pass `plan`, its image and its FLIP

@@ -155,9 +155,9 @@ itself; with each further visibility of the run (`voxels N`: the grid, N cells a
 reference. The truth's noise adds to every error against it in quadrature.\n\n");
     // The visibilities of the references but `none`: a column each.
     let reference = |s: &str, v: &str| {
-        o.rows
-            .iter()
-            .find(|r| r.scene == s && r.method == "reference" && r.visibility == v)
+        o.rows.iter().find(|r| {
+            r.scene == s && r.method == crate::methods::REFERENCE.name() && r.visibility == v
+        })
     };
     let others: Vec<&str> = visibilities(&o.rows)
         .into_iter()
@@ -165,7 +165,7 @@ reference. The truth's noise adds to every error against it in quadrature.\n\n")
             v != "none"
                 && o.rows
                     .iter()
-                    .any(|r| r.method == "reference" && r.visibility == v)
+                    .any(|r| r.method == crate::methods::REFERENCE.name() && r.visibility == v)
         })
         .collect();
     md += "| scene | model error |";

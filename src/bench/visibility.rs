@@ -231,7 +231,7 @@ fn pairs<'a>(rows: &'a [Row], scene: &str, other: &str) -> Vec<(&'a Row, &'a Row
             Some((a, b))
         })
         .collect();
-    out.sort_by_key(|(a, _)| a.method != "reference");
+    out.sort_by_key(|(a, _)| a.method != crate::methods::REFERENCE.name());
     out
 }
 

@@ -58,6 +58,9 @@ pub const SUBJECT: Method = hisr::KEY;
 /// against (method error), left out of the other methods' fronts.
 pub const REFERENCE: Method = reference::KEY;
 
+/// The method that adds no indirect light: direct light alone.
+pub const DIRECT_ONLY: Method = none::KEY;
+
 /// What a method is, before anything is made: everything the CLI, the
 /// checks, the viewer and the bench need to know of it.
 pub trait Descriptor: Sync {
