@@ -11,8 +11,8 @@
 // (multires/gather_list.frag for a list of light patches, hisr/gather.frag
 // for HISR's traversal). With the stencil off (a measurement baseline) every
 // texel is shaded and non-patches are masked afterwards.
-#ifndef MULTIRES_GATHER_GLSL
-#define MULTIRES_GATHER_GLSL
+#ifndef GATHER_FRAME_GLSL
+#define GATHER_FRAME_GLSL
 #include "frame.glsl"
 #include "light_types.glsl"
 #include "vpl.glsl"
