@@ -4,8 +4,9 @@
 //!
 //! Reading order: `renderer` (creates, records, submits), `frame` (what every
 //! pass shares), `passes` (one module per shared pass), `methods` (one module
-//! per indirect method), `multires` (the eye-space hierarchy), `vk` (device,
-//! resources, barriers, pipelines, timing), `scene`. The README has the map.
+//! per indirect method, and their registry), `multires` (the eye-space
+//! framework), `voxel_grid` and `visibility`, `vk` (device, resources,
+//! barriers, pipelines, timing), `scene`. docs/architecture.md has the map.
 
 pub mod bench;
 pub mod cli;

@@ -1,4 +1,5 @@
-//! The crate's modules depend downwards only (README, "Code map"): every
+//! The crate's modules depend downwards only (docs/architecture.md, "Code
+//! map"): every
 //! `crate::MODULE` a file of `src/MODULE/` or `src/MODULE.rs` names is a
 //! module of a lower layer. Read from the source text: `use crate::a::b`,
 //! `use crate::{a, b::c}` and paths written inline (`crate::a::f()`).
@@ -13,11 +14,14 @@ const LAYERS: &[&[&str]] = &[
     &["view", "vk"],
     &["frame"],
     &["passes"],
+    &["voxel_grid"],
+    &["visibility"],
     &["multires"],
+    &["regular_vpls"],
     &["methods", "readback"],
-    &["debug_view", "output"],
+    &["method_args", "debug_view", "output"],
     &["renderer", "pathtrace"],
-    &["report", "soak", "visibility"],
+    &["report", "soak", "exact_visibility"],
     &["viewer", "bench"],
     &["cli"],
 ];
