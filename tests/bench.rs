@@ -169,6 +169,9 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     }
     let report = std::fs::read_to_string(dir.join(files::REPORT)).unwrap();
     assert!(report.contains("## Model error") && report.contains("RMSE truth"));
+    assert!(report.contains("## Best balance"), "{report}");
+    let headline = isr::bench::publish::block(&report).expect("the headline block");
+    assert!(headline.contains("| `hisr` (tau "), "{headline}");
     errors_fall_as_the_cost_rises(rows);
     let csv = std::fs::read_to_string(dir.join(files::RESULTS_CSV)).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
@@ -182,10 +185,38 @@ fn quick_bench_writes_every_output_with_finite_numbers_and_resumes() {
     let before = lines(&journal);
     let truth = files::truth_dir(&dir, "slats").join("frame-2.exr");
     let traced = std::fs::metadata(&truth).unwrap().modified().unwrap();
+    // ... and publishes: the report as docs/results.md, its headline block
+    // into README.md between the markers, the rest of README.md kept.
+    let root = dir.join("repository");
+    std::fs::create_dir_all(&root).unwrap();
+    let readme = format!(
+        "# title\n\n{}\nold table\n{}\n\nafter\n",
+        isr::bench::publish::BEGIN,
+        isr::bench::publish::END
+    );
+    std::fs::write(root.join("README.md"), &readme).unwrap();
     Isr::new("bench")
-        .args(["--quick", "--out-dir", d])
+        .args([
+            "--quick",
+            "--out-dir",
+            d,
+            "--publish",
+            root.to_str().unwrap(),
+        ])
         .succeeds();
     assert_eq!(lines(&journal), before);
+    let published = std::fs::read_to_string(root.join("docs/results.md")).unwrap();
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(readme.starts_with("# title\n\n") && readme.ends_with("\n\nafter\n"));
+    assert!(!readme.contains("old table"));
+    assert_eq!(
+        isr::bench::publish::block(&readme),
+        isr::bench::publish::block(&published)
+    );
+    assert!(published.contains("](results/speed_vs_truth.svg)"));
+    for f in [files::RESULTS_CSV, files::GALLERY, "speed_vs_truth.png"] {
+        assert!(root.join("docs/results").join(f).exists(), "{f}");
+    }
     // An interrupted run: drop the last rows; the rerun renders only those.
     let text = std::fs::read_to_string(&journal).unwrap();
     let kept: Vec<&str> = text.lines().take(before - 3).collect();

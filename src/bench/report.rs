@@ -58,16 +58,20 @@ fn cell<T: std::fmt::Display>(v: Option<T>) -> String {
     v.map_or("-".into(), |v| v.to_string())
 }
 
-/// `report.md`: run facts, charts, ratios and one table per scene.
-pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio]) -> String {
+/// `report.md`: run facts, the headline tables, charts, best balances,
+/// ratios and one table per scene; its images are at `images` (a folder
+/// prefix: "" beside it, `results/` when published into docs/).
+pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio], images: &str) -> String {
     let b = &plan.base;
     let mut md = format!(
-        "# isr bench\n\nDevice: **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
+        "# isr bench\n\n`{}` on {}: device **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
 (1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
 section 6.2), errors means over frames against the dense reference of the same frame (section 6.1) \
 and against the path-traced truth (section 6.6), flicker over the sequence (section 6.3), FLIP on the \
 tone-mapped final image (section 6.4). Indirect visibility: {} (section 6.7; a row with it is held \
 against the dense reference with it, and the one truth of each frame).{}\n\n",
+        o.command,
+        o.date,
         o.device,
         o.driver,
         b.width,
@@ -85,9 +89,13 @@ against the dense reference with it, and the one truth of each frame).{}\n\n",
             Chart::Flicker => "flicker",
             Chart::Passes => "per-pass times",
         };
-        md += &format!("![{alt}]({})\n\n", chart.svg());
+        md += &format!("![{alt}]({images}{})\n\n", chart.svg());
     }
-    md += &format!("![gallery]({})\n\n", files::GALLERY);
+    md += &format!("![gallery]({images}{})\n\n", files::GALLERY);
+    md += "## At each method's default, against the truth\n\n";
+    md += &super::publish::headline(plan, o);
+    md += &super::publish::balance_section(o);
+    md += "\n";
     md += &model_errors(plan, o);
     md += &flicker_table(plan, o);
     md += &super::visibility::report_table(plan, &o.rows);
@@ -237,6 +245,6 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         .map(|p| (p.visibility_label(), p.image_suffix()))
         .collect();
     super::gallery::gallery(dir, &o.rows, &scenes, &methods, &passes)?;
-    crate::output::write_text(&dir.join(files::REPORT), &markdown(plan, o, &ratios))?;
+    crate::output::write_text(&dir.join(files::REPORT), &markdown(plan, o, &ratios, ""))?;
     Ok(())
 }
