@@ -13,7 +13,6 @@ pub mod gltf_load;
 pub mod limits;
 pub mod motion;
 pub mod obj_load;
-pub mod one_texture;
 mod texture_decode;
 mod uri;
 
