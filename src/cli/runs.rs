@@ -110,8 +110,18 @@ pub(super) fn sequence(
         let t = args.run.time + k as f32 / args.fps;
         renderer.update(&args.state_at(scene, t)?)?;
         // Each frame is its own run of one frame: its images are read back
-        // before the next one changes the scene.
-        let stats = renderer.render_frames(1, |_| {}).map_err(|e| {
+        // and written before the next one changes the scene. Whatever of it
+        // fails (the frame, its readback, its files) names what is kept.
+        let exr = dir.join(format!("frame_{k:04}.exr"));
+        let png = dir.join(format!("frame_{k:04}.png"));
+        let frame = (|| -> Result<(crate::renderer::FrameStats, Vec<u8>)> {
+            let stats = renderer.render_frames(1, |_| {})?;
+            let result = renderer.readback()?;
+            output::write_exr(&exr, &result)?;
+            output::write_png(&png, result.width, result.height, &result.display)?;
+            Ok((stats, result.display))
+        })();
+        let (stats, display) = frame.map_err(|e| {
             bar.abandon();
             e.context(format!(
                 "rendering frame {k} (t = {t} s) failed; {}timings.json was not written",
@@ -126,11 +136,6 @@ pub(super) fn sequence(
                 }
             ))
         })?;
-        let result = renderer.readback()?;
-        let exr = dir.join(format!("frame_{k:04}.exr"));
-        let png = dir.join(format!("frame_{k:04}.png"));
-        output::write_exr(&exr, &result)?;
-        output::write_png(&png, result.width, result.height, &result.display)?;
         super::interrupt::set_note(format!(
             "{} in {} complete; timings.json was not written",
             match k {
@@ -140,7 +145,7 @@ pub(super) fn sequence(
             dir.display()
         ));
         if args.gif {
-            gif_frames.push(result.display);
+            gif_frames.push(display);
         }
         let mut r = args.report(gpu, scene, &stats);
         r.time = Some(t);
