@@ -35,22 +35,7 @@ use std::time::{Duration, Instant};
 static ALLOC: Counting = Counting;
 
 /// Tight budgets so that what they allow is small and anything else stands out.
-const FUZZ_LIMITS: Limits = Limits {
-    scene_file_bytes: 8 << 20,
-    line_bytes: 1 << 20,
-    material_library_bytes: 1 << 20,
-    description_bytes: 1 << 16,
-    buffer_bytes: 8 << 20,
-    image_file_bytes: 1 << 20,
-    texture_dimension: 1024,
-    texture_pixels: 1 << 18,
-    node_visits: 1 << 12,
-    hierarchy_depth: 64,
-    triangles: 1 << 15,
-    vertices: 1 << 15,
-    coordinate: 1e6,
-    min_extent: 1e-6,
-};
+const FUZZ_LIMITS: Limits = Limits::FUZZ;
 /// More than the budgets above can account for (a few copies of 8 MiB of
 /// buffers, 32k vertices, 256k texels).
 const MAX_PEAK: usize = 96 << 20;
