@@ -3,8 +3,16 @@
 //! read outside the scene's folder (issue 27). Most run through the release
 //! binary (`common::cli`); the bounded read of a file of 10^8 `v` lines and
 //! the budgets run in process, where the bytes taken and allocated can be
-//! counted.
+//! counted. Modules: `budgets` (memory in proportion to the file, one
+//! warning per kind), `images` (normals, texture coordinates, triangle
+//! order), `text` (byte-order marks, line ends, escapes, messages).
+#[path = "obj_hostile/budgets.rs"]
+mod budgets;
 mod common;
+#[path = "obj_hostile/images.rs"]
+mod images;
+#[path = "obj_hostile/text.rs"]
+mod text;
 
 use common::cli::Isr;
 use common::gltf::{png, png_header_only};

@@ -139,7 +139,7 @@ impl State {
             let sum: DVec3 = normals.iter().flatten().map(|n| n.as_dvec3()).sum();
             if sum.dot(cross) < 0.0 {
                 corners.swap(1, 2);
-                let at = self.at();
+                let at = self.here();
                 self.tally.rewound.add(|| at);
             }
         } else {

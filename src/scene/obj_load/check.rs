@@ -198,7 +198,7 @@ pub(super) fn line(raw: &[u8], st: &mut State) -> Result<()> {
             }
             let unit = crate::scene::direction(Vec3::new(n[0], n[1], n[2]));
             if unit.is_none() {
-                let at = st.at();
+                let at = st.here();
                 st.tally.zero_normals.add(|| at);
             }
             // A zero normal is kept as zero: faces using it get computed
@@ -217,7 +217,7 @@ pub(super) fn line(raw: &[u8], st: &mut State) -> Result<()> {
             }
             let found = st.materials.by_name.get(rest).copied();
             if found.is_none() {
-                let at = st.at();
+                let at = st.here();
                 st.tally.unknown_materials.add(rest, "", || at);
             }
             st.select(found);
@@ -237,7 +237,7 @@ pub(super) fn line(raw: &[u8], st: &mut State) -> Result<()> {
                 .iter()
                 .find(|(k, _)| *k == key)
                 .map_or("it is not part of the OBJ format isr reads", |(_, why)| why);
-            let at = st.at();
+            let at = st.here();
             st.tally.ignored_statements.add(key, why, || at);
         }
     }
@@ -284,11 +284,11 @@ fn face<'a>(words: impl Iterator<Item = &'a str>, st: &mut State) -> Result<()> 
         );
     }
     if with_normal > 0 && with_normal < corners {
-        let at = st.at();
+        let at = st.here();
         st.tally.partial_normals.add(|| at);
     }
     if with_uv > 0 && with_uv < corners {
-        let at = st.at();
+        let at = st.here();
         st.tally.partial_texcoords.add(|| at);
     }
     Ok(())

@@ -148,6 +148,10 @@ fn load_checked(
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
     let mut st = State {
         display: display(path),
+        name: path.file_name().map_or_else(
+            || display(path),
+            |n| super::text::quote(&n.to_string_lossy()),
+        ),
         base,
         options: options.clone(),
         line: 0,
@@ -180,8 +184,9 @@ fn load_checked(
 
 /// What the lines read so far defined.
 struct State {
-    /// The OBJ file, for messages.
+    /// The OBJ file, for messages; and its name alone, for warnings.
     display: String,
+    name: String,
     /// The scene's folder: libraries and textures are confined to it.
     base: PathBuf,
     options: LoadOptions,
@@ -206,6 +211,12 @@ impl State {
     /// "scene.obj line N", for messages.
     fn at(&self) -> String {
         format!("{} line {}", self.display, self.line.max(1))
+    }
+
+    /// "scene.obj line N" with the file's name alone, for warnings, which
+    /// list several places and are said after the file is named.
+    fn here(&self) -> String {
+        format!("{} line {}", self.name, self.line.max(1))
     }
 }
 

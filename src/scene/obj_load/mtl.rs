@@ -331,9 +331,17 @@ pub(super) fn texture(
 
 fn decode(path: &Path, limits: &limits::Limits, textures: &mut Textures) -> Result<Texture> {
     let bytes = crate::scene::uri::read_capped(path, limits.image_file_bytes, "the image file")?;
-    let label = path.file_name().map_or_else(
-        || path.display().to_string(),
+    let name = path.file_name().map_or_else(
+        || crate::scene::text::path(path),
         |n| quote(&n.to_string_lossy()),
     );
-    crate::scene::texture_decode::decode_texture(&bytes, label, limits, &mut textures.pixels)
+    // The message's context names the file already ("map_Kd t.png").
+    let mut t = crate::scene::texture_decode::decode_texture(
+        &bytes,
+        "the texture".into(),
+        limits,
+        &mut textures.pixels,
+    )?;
+    t.name = name;
+    Ok(t)
 }
