@@ -197,6 +197,13 @@ fn degenerate_cameras_are_refused() {
         ("znear", 1e-45, "znear"),
         ("yfov", 3.5, "yfov"),
         ("yfov", 1e-40, "yfov"),
+        // Finite scale, but narrower than f32 tells a pixel's rays apart:
+        // accepted before (a black image).
+        (
+            "yfov",
+            1e-20,
+            "yfov 1e-20 radians: the vertical field of view must be between",
+        ),
         // A znear that is a normal float but underflows against the scene.
         ("znear", 1e-35, "depths would underflow"),
     ] {

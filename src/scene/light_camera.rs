@@ -133,6 +133,32 @@ impl Camera {
     }
 }
 
+/// Whether a camera with the vertical field of view `yfov` (radians) can
+/// render: its projection's scale `1 / tan(yfov / 2)` within [1e-6, 1e6],
+/// so `yfov` within about [2e-6, pi - 2e-6]. Narrower, neighbouring pixels'
+/// rays differ by less than f32 tells apart from the camera's own
+/// direction (measured on the built-in box: a view 1.7e-7 radians wide
+/// renders, at 1.7e-8 a quarter of the image is black, at 1.7e-22 three
+/// quarters); wider, the scale rounds to 0. The same bound for glTF
+/// cameras, descriptions and `--camera`. The error says why.
+pub fn check_yfov(yfov: f32) -> Result<(), String> {
+    let f = 1.0 / (0.5 * yfov as f64).tan();
+    if yfov > 0.0 && yfov < std::f32::consts::PI && (1e-6..=1e6).contains(&f) {
+        return Ok(());
+    }
+    Err(format!(
+        "the vertical field of view must be between {:.2e} and {:.6} degrees ({:.0e} to pi - {:.0e} radians: a view narrower than that is finer than 32-bit floats resolve)",
+        MIN_YFOV.to_degrees(),
+        (std::f64::consts::PI - MIN_YFOV as f64).to_degrees(),
+        MIN_YFOV,
+        MIN_YFOV
+    ))
+}
+
+/// The narrowest field of view [`check_yfov`] allows, radians (the widest
+/// is pi minus it).
+pub const MIN_YFOV: f32 = 2e-6;
+
 /// The rotation and translation of `m`, without its scale: `None` when `m`
 /// is not finite or maps some direction to (nearly) zero (a scale of 0),
 /// so that it has no orientation.

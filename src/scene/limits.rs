@@ -119,7 +119,11 @@ impl Limits {
         let (lo, hi) = scene
             .bounds()
             .ok_or_else(|| anyhow::anyhow!("the scene has no vertices to render"))?;
-        let reach = lo.abs().max(hi.abs()).max_element();
+        // In world metres: the scene's origin counted in, in f64.
+        let o = scene.origin;
+        let reach = ((o + lo.as_dvec3()).abs())
+            .max((o + hi.as_dvec3()).abs())
+            .max_element() as f32;
         if reach.is_nan() || reach > self.coordinate {
             anyhow::bail!(
                 "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m ({shrink})",

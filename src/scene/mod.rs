@@ -23,7 +23,8 @@ mod uri;
 pub use geometry::{compute_normals, cuboid, direction, quad};
 pub use gltf_load::LoadOptions;
 pub use light_camera::{
-    render_origin, render_origin_cell, rigid, Camera, Light, LightKind, SpotLight,
+    check_yfov, render_origin, render_origin_cell, rigid, Camera, Light, LightKind, SpotLight,
+    MIN_YFOV,
 };
 
 /// What kind of scene file a path names, by its extension.
@@ -147,6 +148,23 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
+/// The origin a loader stores a scene relative to ([`Scene::origin`]),
+/// from its world bounds `lo`, `hi` (f64): zero for a scene whose centre is
+/// within its own extent of the world's origin (every scene built around
+/// it keeps its numbers, bit for bit), else its centre snapped to a grid
+/// whose cell is the power of two at or above its extent. Relative to it,
+/// positions are within an extent of zero and keep the precision they have
+/// at home; snapped, a scene moved by whole cells gets the same numbers.
+pub fn scene_origin(lo: glam::DVec3, hi: glam::DVec3) -> glam::DVec3 {
+    let centre = (lo + hi) * 0.5;
+    let extent = (hi - lo).max_element();
+    if !(extent > 0.0 && centre.is_finite()) || centre.abs().max_element() <= extent {
+        return glam::DVec3::ZERO;
+    }
+    let cell = 2f64.powi(extent.log2().ceil() as i32);
+    (centre / cell).round() * cell
+}
+
 /// What changes from frame to frame: where the camera and the light are and
 /// where every mesh instance is. The renderer takes one per frame
 /// (`Renderer::update`); nothing else about the scene changes between frames.
@@ -216,6 +234,16 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// What moves over time; `None` for a still scene (and scenes built by code).
     pub animation: Option<animation::Animation>,
+    /// Where the scene's coordinates start, in world metres: every
+    /// position of the scene (vertices through their instances, lights,
+    /// the camera, the animation) is relative to it. Zero unless a loader
+    /// found the scene far from the world's origin for its size
+    /// ([`scene_origin`]): it then composed the file's transforms in f64
+    /// and subtracted this before rounding to f32, so that a scene moved
+    /// by 9e5 m renders as it does at home. Budgets on coordinates count
+    /// it in; the renderer never needs it (images do not depend on where
+    /// the scene is).
+    pub origin: glam::DVec3,
 }
 
 impl Scene {
@@ -231,6 +259,7 @@ impl Scene {
             camera,
             warnings: vec![],
             animation: None,
+            origin: glam::DVec3::ZERO,
         }
     }
 
@@ -357,13 +386,14 @@ impl Scene {
                 continue;
             };
             let mesh = &self.meshes[inst.mesh];
+            // In world metres: the scene's origin counted in, in f64.
             let reach = mesh
                 .vertices
                 .iter()
                 .map(|v| {
-                    m.transform_point3(Vec3::from(v.position))
+                    (self.origin + m.transform_point3(Vec3::from(v.position)).as_dvec3())
                         .abs()
-                        .max_element()
+                        .max_element() as f32
                 })
                 .fold(0.0f32, |r, x| {
                     if x.is_nan() || r.is_nan() {

@@ -112,6 +112,20 @@ pub fn path<P: AsRef<std::path::Path> + ?Sized>(p: &P) -> String {
     quote_at_most(&p.as_ref().display().to_string(), PATH_CHARS)
 }
 
+/// `x` for a message: in scientific notation where plain notation would
+/// be long (1e-40 is forty digits as `{}` writes it).
+pub fn number<T>(x: T) -> String
+where
+    T: Into<f64> + Copy + std::fmt::Display + std::fmt::LowerExp,
+{
+    let v: f64 = x.into();
+    if v != 0.0 && v.is_finite() && !(1e-3..1e9).contains(&v.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// `s` without a UTF-8 byte-order mark at its start: editors on Windows
 /// write one, and it is no part of the first keyword.
 pub fn strip_bom(s: &[u8]) -> &[u8] {

@@ -10,7 +10,7 @@ use crate::scene::animation::{
 };
 use crate::scene::{Camera, Light, LightKind};
 use anyhow::{anyhow, bail, Result};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{DVec3, Mat4, Vec3, Vec4};
 
 fn vec3(a: [f32; 3], what: &str) -> Result<Vec3> {
     let v = Vec3::from(a);
@@ -20,14 +20,19 @@ fn vec3(a: [f32; 3], what: &str) -> Result<Vec3> {
     Ok(v)
 }
 
-/// A position, within the coordinate budget (`Limits::coordinate`).
-pub(super) fn point(a: [f32; 3], what: &str) -> Result<Vec3> {
-    let v = vec3(a, what)?;
+/// A position in world metres, within the coordinate budget
+/// (`Limits::coordinate`), relative to the scene's origin (`Scene::origin`,
+/// subtracted in f64).
+pub(super) fn point(a: [f64; 3], what: &str, origin: DVec3) -> Result<Vec3> {
+    let v = DVec3::from(a);
+    if !v.is_finite() {
+        bail!("{what} {a:?} is not finite");
+    }
     let limit = crate::scene::limits::Limits::DEFAULT.coordinate;
-    if v.abs().max_element() > limit {
+    if v.abs().max_element() > limit as f64 {
         bail!("{what} {a:?} reaches beyond {limit:.0e} m, the largest coordinate isr supports");
     }
-    Ok(v)
+    Ok((v - origin).as_vec3())
 }
 
 /// One keyframe resolved: time, position, where it points.
@@ -37,29 +42,39 @@ pub(super) struct Pose {
     direction: Vec3,
 }
 
-pub(super) fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<Pose>>)> {
+/// The light `spec` gives (positions in world metres) in the scene's frame:
+/// `pivot` its centre, `origin` where its coordinates start.
+pub(super) fn light(
+    spec: &LightSpec,
+    pivot: Vec3,
+    origin: DVec3,
+) -> Result<(Light, Option<Vec<Pose>>)> {
     let kind = match spec.kind.trim().to_ascii_lowercase().as_str() {
         "spot" => LightKind::Spot,
         "point" => LightKind::Point,
         "directional" | "sun" => LightKind::Directional,
-        other => bail!("type {other:?}: a light is spot, point or directional"),
+        other => bail!(
+            "type '{}': a light is spot, point or directional",
+            crate::scene::text::quote(other)
+        ),
     };
     let first = spec.path.as_ref().and_then(|p| p.first());
     let position = spec.position.or(first.and_then(|k| k.position));
     let target = spec.target.or(first.and_then(|k| k.target));
     let direction = spec.direction.or(first.and_then(|k| k.direction));
+    let point = |a: [f64; 3], what: &str| point(a, what, origin);
     let (position, direction) = match kind {
         LightKind::Directional => {
             if spec.target.is_some() && direction.is_none() {
-                let p = vec3(position.ok_or_else(|| anyhow!("a directional light with a target needs a position (the rays go from it to the target), or give its direction"))?, "position")?;
-                let t = vec3(target.unwrap_or_default(), "target")?;
+                let p = point(position.ok_or_else(|| anyhow!("a directional light with a target needs a position (the rays go from it to the target), or give its direction"))?, "position")?;
+                let t = point(target.unwrap_or_default(), "target")?;
                 (p, t - p)
             } else {
                 let d = direction.ok_or_else(|| {
                     anyhow!("a directional light needs a direction (its rays, e.g. [0.3, -1, 0.2])")
                 })?;
                 (
-                    position.map_or(Ok(pivot), |p| vec3(p, "position"))?,
+                    position.map_or(Ok(pivot), |p| point(p, "position"))?,
                     vec3(d, "direction")?,
                 )
             }
@@ -78,7 +93,7 @@ pub(super) fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<
             (p, d)
         }
     };
-    let Some(direction) = direction.try_normalize() else {
+    let Some(direction) = crate::scene::direction(direction) else {
         bail!("the light points nowhere: its target is its position (or its direction is zero)");
     };
     let color = vec3(spec.color.unwrap_or([1.0; 3]), "color")?;
@@ -97,7 +112,10 @@ pub(super) fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<
     let reach = match kind {
         LightKind::Directional => 1.0,
         _ => {
-            let aim = target.map(Vec3::from).unwrap_or(pivot);
+            let aim = match target {
+                Some(t) => point(t, "target")?,
+                None => pivot,
+            };
             (aim - position).length().max(1e-6)
         }
     };
@@ -138,18 +156,22 @@ pub(super) fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<
             position,
             direction,
         },
-        target.map(Vec3::from),
+        target.map(|t| point(t, "target")).transpose()?,
         kind == LightKind::Directional,
         pivot,
+        origin,
     )?;
     Ok((light, motion))
 }
 
+/// The camera `spec` gives, in the scene's frame, as [`light`].
 pub(super) fn camera(
     spec: &CameraSpec,
     pivot: Vec3,
     diagonal: f32,
+    origin: DVec3,
 ) -> Result<(Camera, Option<Vec<Pose>>)> {
+    let point = |a: [f64; 3], what: &str| point(a, what, origin);
     let first = spec.path.as_ref().and_then(|p| p.first());
     let position = spec
         .position
@@ -161,13 +183,12 @@ pub(super) fn camera(
         Some(t) => point(t, "target")?,
         None => pivot,
     };
-    let Some(direction) = (target - position).try_normalize() else {
+    let Some(direction) = crate::scene::direction(target - position) else {
         bail!("the camera's target is its position: it looks nowhere");
     };
     let fov = spec.fov.unwrap_or(45.0);
-    if !(fov > 0.0 && fov < 180.0) {
-        bail!("fov {fov}: the vertical field of view is more than 0 and less than 180 degrees");
-    }
+    crate::scene::check_yfov(fov.to_radians())
+        .map_err(|why| anyhow!("fov {} (degrees): {why}", crate::scene::text::number(fov)))?;
     let far = (diagonal + (position - pivot).length()).max(f32::MIN_POSITIVE);
     let znear = spec
         .znear
@@ -197,6 +218,7 @@ pub(super) fn camera(
         Some(target),
         false,
         pivot,
+        origin,
     )?;
     Ok((camera, motion))
 }
@@ -209,7 +231,9 @@ fn motion(
     target: Option<Vec3>,
     directional: bool,
     pivot: Vec3,
+    origin: DVec3,
 ) -> Result<Option<Vec<Pose>>> {
+    let point = |a: [f64; 3], what: &str| point(a, what, origin);
     match (path, orbit) {
         (None, None) => Ok(None),
         (Some(_), Some(_)) => bail!("give a path or an orbit, not both"),
@@ -237,7 +261,7 @@ fn motion(
                         direction = t - position;
                     }
                 }
-                let Some(d) = direction.try_normalize() else {
+                let Some(d) = crate::scene::direction(direction) else {
                     bail!("{}", what("the target is the position: it points nowhere"));
                 };
                 out.push(Pose {
@@ -257,7 +281,7 @@ fn motion(
                 bail!("orbit turns {turns}: a positive number, at most 1000");
             }
             let center = match o.center {
-                Some(c) => vec3(c, "orbit center")?,
+                Some(c) => point(c, "orbit center")?,
                 None => pivot,
             };
             let aim = if directional {
@@ -276,7 +300,9 @@ fn motion(
                     let rot = glam::Quat::from_rotation_y(std::f32::consts::TAU * s);
                     let position = center + rot * (rest.position - center);
                     let direction = match aim {
-                        Some(a) => (a - position).normalize_or(rot * rest.direction),
+                        Some(a) => {
+                            crate::scene::direction(a - position).unwrap_or(rot * rest.direction)
+                        }
                         None => rot * rest.direction,
                     };
                     Pose {
@@ -285,7 +311,26 @@ fn motion(
                         direction,
                     }
                 })
-                .collect();
+                .collect::<Vec<Pose>>();
+            // The circle through the rest position, whatever the centre:
+            // held to the coordinate budget as every key of a path is.
+            let limit = crate::scene::limits::Limits::DEFAULT.coordinate;
+            let far = out
+                .iter()
+                .map(|k| (origin + k.position.as_dvec3()).abs().max_element() as f32)
+                .fold(0f32, |m, r| {
+                    if m.is_nan() || r.is_nan() {
+                        f32::NAN
+                    } else {
+                        m.max(r)
+                    }
+                });
+            if !(far <= limit) {
+                bail!(
+                    "the orbit about {} reaches {far:.3e} m from the origin; isr supports coordinates up to {limit:.0e} m",
+                    origin + center.as_dvec3()
+                );
+            }
             Ok(Some(out))
         }
     }

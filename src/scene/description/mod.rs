@@ -123,16 +123,19 @@ struct Room {
     albedo: Option<serde_json::Value>,
 }
 
-/// A light as a description or `--light` gives it.
+/// A light as a description or `--light` gives it. Places (position,
+/// target, an orbit's centre) are world metres in f64: a scene stored
+/// relative to an origin of its own (`Scene::origin`) gets them relative
+/// to it, rounded to f32 only then.
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
     #[serde(rename = "type")]
     pub kind: String,
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     #[serde(default)]
     pub direction: Option<[f32; 3]>,
     #[serde(default)]
@@ -158,9 +161,9 @@ pub struct LightSpec {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     /// Vertical field of view, degrees.
     #[serde(default)]
     pub fov: Option<f32>,
@@ -178,9 +181,9 @@ pub struct CameraSpec {
 pub struct Key {
     pub t: f32,
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     #[serde(default)]
     pub direction: Option<[f32; 3]>,
 }
@@ -191,7 +194,7 @@ pub struct Key {
 pub struct Orbit {
     pub period: f32,
     #[serde(default)]
-    pub center: Option<[f32; 3]>,
+    pub center: Option<[f64; 3]>,
     #[serde(default)]
     pub turns: Option<f32>,
 }
@@ -219,14 +222,18 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             super::limits::bytes(options.limits.description_bytes)
         );
     }
+    // A byte-order mark (editors on Windows write one) is no JSON value.
+    let bytes = super::text::strip_bom(bytes);
     let d: Description = serde_json::from_slice(bytes).map_err(|e| {
         let at = format!(" at line {} column {}", e.line(), e.column());
         let message = e.to_string();
+        // serde's message quotes the file (an unknown field's name, a
+        // string of the wrong type): escaped and cut like any file text.
         anyhow!(
             "line {} column {}: {} (the format: README, \"Scenes from the archives\")",
             e.line(),
             e.column(),
-            message.strip_suffix(&at).unwrap_or(&message)
+            super::text::quote_at_most(message.strip_suffix(&at).unwrap_or(&message), 300)
         )
     })?;
     let folder = path
@@ -236,15 +243,15 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     let allow = options.allow_outside_uris;
     let mesh = match &d.mesh {
         serde_json::Value::String(name) => files::resolve(name, Path::new(""), &folder, allow)
-            .with_context(|| format!("mesh {name}"))?,
+            .with_context(|| format!("mesh {}", super::text::quote(name)))?,
         serde_json::Value::Object(o) if o.len() == 1 && o.get("archive").is_some_and(|v| v.is_string()) => {
             let name = o["archive"].as_str().unwrap_or_default();
             let root = archive_root();
             if !root.is_dir() {
-                bail!("mesh {{\"archive\": {name:?}}}: {} is not a folder; {}", root.display(), archive_hint());
+                bail!("mesh {{\"archive\": \"{}\"}}: {} is not a folder; {}", super::text::quote(name), root.display(), archive_hint());
             }
             files::resolve(name, Path::new(""), &root, allow).with_context(|| {
-                format!("mesh {{\"archive\": {name:?}}} in {} ({})", root.display(), archive_hint())
+                format!("mesh {{\"archive\": \"{}\"}} in {} ({})", super::text::quote(name), root.display(), archive_hint())
             })?
         }
         other => bail!(
@@ -293,7 +300,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         let l = fitted_light(lo, hi);
         scene.warnings.push(format!(
             "the description has no lights: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd)",
-            l.position.to_array(),
+            (scene.origin + l.position.as_dvec3()).to_array(),
             l.intensity
         ));
         scene.lights = vec![l];
@@ -333,7 +340,8 @@ pub fn apply(
         animation.lights.clear();
         scene.lights.clear();
         for (i, (label, spec)) in lights.iter().enumerate() {
-            let (light, motion) = light(spec, pivot).with_context(|| label.clone())?;
+            let (light, motion) =
+                light(spec, pivot, scene.origin).with_context(|| label.clone())?;
             scene.lights.push(light);
             if let Some(keys) = motion {
                 let node = add_path(&mut animation, &keys).with_context(|| label.clone())?;
@@ -343,7 +351,7 @@ pub fn apply(
     }
     if let Some(c) = camera {
         animation.camera = None;
-        let (cam, motion) = self::camera(c, pivot, diagonal).context("camera")?;
+        let (cam, motion) = self::camera(c, pivot, diagonal, scene.origin).context("camera")?;
         scene.camera = cam;
         if let Some(keys) = motion {
             let node = add_path(&mut animation, &keys).context("camera")?;
@@ -367,7 +375,10 @@ fn up_rotation(up: &str) -> Result<glam::Quat> {
         "-z" => glam::Quat::from_rotation_x(FRAC_PI_2),
         "+x" | "x" => glam::Quat::from_rotation_z(FRAC_PI_2),
         "-x" => glam::Quat::from_rotation_z(-FRAC_PI_2),
-        other => bail!("up {other:?}: the file's up axis is one of +y, -y, +z, -z, +x, -x"),
+        _ => bail!(
+            "up '{}': the file's up axis is one of +y, -y, +z, -z, +x, -x",
+            super::text::quote(up)
+        ),
     })
 }
 
@@ -399,6 +410,9 @@ fn place(scene: &mut Scene, m: Mat4, scale: f32) {
         c.world_from_camera = w;
     }
     c.znear *= scale;
+    // The scene's own origin is placed too (a rotation and a scale: no
+    // translation), in f64.
+    scene.origin = m.as_dmat4().transform_point3(scene.origin);
 }
 
 /// The coordinate budget and the smallest scene, after placement.
@@ -406,7 +420,10 @@ fn check_reach(scene: &Scene, options: &LoadOptions) -> Result<()> {
     let (lo, hi) = scene
         .bounds()
         .ok_or_else(|| anyhow!("the mesh has no vertices"))?;
-    let reach = lo.abs().max(hi.abs()).max_element();
+    let o = scene.origin;
+    let reach = ((o + lo.as_dvec3()).abs())
+        .max((o + hi.as_dvec3()).abs())
+        .max_element() as f32;
     let limits = &options.limits;
     if reach.is_nan() || reach > limits.coordinate {
         bail!(

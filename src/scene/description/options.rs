@@ -26,8 +26,8 @@ pub fn parse_light(s: &str) -> Result<LightSpec, String> {
     for part in parts {
         let (key, value) = key_value(part)?;
         match key {
-            "position" | "pos" => l.position = Some(vector(key, value)?),
-            "target" => l.target = Some(vector(key, value)?),
+            "position" | "pos" => l.position = Some(place(key, value)?),
+            "target" => l.target = Some(place(key, value)?),
             "direction" | "dir" => l.direction = Some(vector(key, value)?),
             "color" | "colour" => l.color = Some(vector(key, value)?),
             "intensity" => l.intensity = Some(number(key, value)?),
@@ -42,7 +42,7 @@ pub fn parse_light(s: &str) -> Result<LightSpec, String> {
         }
     }
     // The checks that need no scene, now: before a device is opened.
-    light(&l, Vec3::ZERO).map_err(|e| format!("{e:#}"))?;
+    light(&l, Vec3::ZERO, glam::DVec3::ZERO).map_err(|e| format!("{e:#}"))?;
     Ok(l)
 }
 
@@ -53,8 +53,8 @@ pub fn parse_camera(s: &str) -> Result<CameraSpec, String> {
     for part in s.split(':') {
         let (key, value) = key_value(part)?;
         match key {
-            "position" | "pos" => c.position = Some(vector(key, value)?),
-            "target" => c.target = Some(vector(key, value)?),
+            "position" | "pos" => c.position = Some(place(key, value)?),
+            "target" => c.target = Some(place(key, value)?),
             "fov" => c.fov = Some(number(key, value)?),
             "znear" => c.znear = Some(number(key, value)?),
             _ => {
@@ -67,7 +67,7 @@ pub fn parse_camera(s: &str) -> Result<CameraSpec, String> {
     if c.position.is_none() {
         return Err("the camera needs a position (position=X,Y,Z)".into());
     }
-    camera(&c, Vec3::ZERO, 1.0).map_err(|e| format!("{e:#}"))?;
+    camera(&c, Vec3::ZERO, 1.0, glam::DVec3::ZERO).map_err(|e| format!("{e:#}"))?;
     Ok(c)
 }
 
@@ -89,6 +89,22 @@ fn vector(key: &str, value: &str) -> Result<[f32; 3], String> {
     let v: Vec<f32> = value
         .split(',')
         .map(|x| number(key, x.trim()))
+        .collect::<Result<_, _>>()?;
+    v.try_into()
+        .map_err(|_| format!("{key}={value}: a vector is X,Y,Z"))
+}
+
+/// A place in world metres, in f64 (`LightSpec::position`).
+fn place(key: &str, value: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = value
+        .split(',')
+        .map(|x| {
+            let x = x.trim();
+            x.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{key}={x}: not a finite number"))
+        })
         .collect::<Result<_, _>>()?;
     v.try_into()
         .map_err(|_| format!("{key}={value}: a vector is X,Y,Z"))
