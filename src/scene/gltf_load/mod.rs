@@ -94,6 +94,13 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     // Budgets first: nothing below allocates more than they allow.
     let plan = measure(doc, &scene)?;
     plan.check(limits)?;
+    let materials = doc.materials().len() as u64;
+    if materials > limits.materials {
+        bail!(
+            "the file has {materials} materials; the limit is {}",
+            limits.materials
+        );
+    }
     let buffers = load_buffers(doc, &base, blob.as_deref(), options)?;
     let mut warnings = Vec::new();
 
@@ -156,8 +163,14 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
                                 m
                             }
                         };
-                        let loaded =
-                            load_primitive(&mesh, &prim, &buffers, material, &mut warnings)?;
+                        let loaded = load_primitive(
+                            &mesh,
+                            &prim,
+                            &buffers,
+                            material,
+                            limits,
+                            &mut warnings,
+                        )?;
                         loaded.map(|m| {
                             out.meshes.push(m);
                             mesh_ids.insert(key, out.meshes.len() - 1);
@@ -339,6 +352,7 @@ fn load_primitive(
     prim: &gltf::Primitive,
     buffers: &[Vec<u8>],
     material: usize,
+    limits: &Limits,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Mesh>> {
     let label = format!(
@@ -462,6 +476,12 @@ fn load_primitive(
         for (i, (v, uv)) in vertices.iter_mut().zip(uvs).enumerate() {
             if !uv.iter().all(|c| c.is_finite()) {
                 bail!("{label}: vertex {i} has a non-finite TEXCOORD_0 {uv:?}");
+            }
+            if uv.iter().any(|c| c.abs() > limits.texcoord) {
+                bail!(
+                    "{label}: vertex {i} has the TEXCOORD_0 {uv:?}; isr supports texture coordinates up to {} (repeats of the texture): beyond, 32-bit floats keep too few bits for a texel",
+                    limits.texcoord
+                );
             }
             v.uv = uv;
         }
