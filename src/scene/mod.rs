@@ -9,6 +9,7 @@ pub mod animation;
 pub mod cornell;
 pub mod description;
 pub mod export;
+pub mod fuzzing;
 mod geometry;
 pub mod gltf_load;
 mod light_camera;

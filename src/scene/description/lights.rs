@@ -53,9 +53,9 @@ pub(super) fn light(
         "spot" => LightKind::Spot,
         "point" => LightKind::Point,
         "directional" | "sun" => LightKind::Directional,
-        other => bail!(
+        _ => bail!(
             "type '{}': a light is spot, point or directional",
-            crate::scene::text::quote(other)
+            crate::scene::text::quote(&spec.kind)
         ),
     };
     let first = spec.path.as_ref().and_then(|p| p.first());
