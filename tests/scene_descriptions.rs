@@ -380,7 +380,7 @@ fn orbit_centres_and_fields_of_view_are_held_to_the_limits() {
     let dark = r
         .direct
         .iter()
-        .filter(|p| !(p[0] + p[1] + p[2] > 0.0))
+        .filter(|p| (p[0] + p[1] + p[2]).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
         .count();
     assert_eq!(dark, 0, "{dark} pixels unlit at fov {fov} degrees");
 }

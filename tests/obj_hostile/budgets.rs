@@ -38,7 +38,7 @@ fn a_library_named_thousands_of_times_is_read_once() {
     assert_eq!(scene.materials[0].name, "m7");
     // The OBJ, the library once, and a few reads of metadata.
     let files = (obj.len() + lib.len()) as u64;
-    assert!(read < files + 16 << 10, "read {read} bytes of {files}");
+    assert!(read < files + (16 << 10), "read {read} bytes of {files}");
     // A line and the library at a time, and the library's materials (a
     // few words each): well under 1 MiB; tobj's merges took 200 MB.
     assert!(peak < 1 << 20, "allocated {} KiB", peak >> 10);

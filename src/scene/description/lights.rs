@@ -325,7 +325,7 @@ fn motion(
                         m.max(r)
                     }
                 });
-            if !(far <= limit) {
+            if far.is_nan() || far > limit {
                 bail!(
                     "the orbit about {} reaches {far:.3e} m from the origin; isr supports coordinates up to {limit:.0e} m",
                     origin + center.as_dvec3()
