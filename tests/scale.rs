@@ -224,6 +224,7 @@ fn a_far_object_changes_nothing() {
         spp: 4,
         seed: 1,
         exposure: 1.0,
+        bounces: isr::bounces::Bounces::ONE,
     };
     let (a, b) = (
         isr::pathtrace::render(&far, &settings, |_, _| {}),

@@ -31,6 +31,7 @@ fn floor_receivers(n: u32, s: f32) -> Readback {
         final_radiance: zero.clone(),
         direct: zero.clone(),
         indirect: zero.clone(),
+        bounces: vec![],
         albedo: zero,
         normal: vec![[0.0, 1.0, 0.0, 0.0]; count],
         position,

@@ -345,6 +345,7 @@ pub fn trace(
                 spp,
                 seed: s,
                 exposure: 1.0,
+                bounces: crate::bounces::Bounces::ONE,
             },
             |_, _| {},
         )
@@ -416,6 +417,7 @@ mod tests {
             final_radiance: empty.clone(),
             direct: empty.clone(),
             indirect: empty.clone(),
+            bounces: vec![],
             albedo: empty,
             normal,
             position,
