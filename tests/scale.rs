@@ -224,6 +224,7 @@ fn a_far_object_changes_nothing() {
         spp: 4,
         seed: 1,
         exposure: 1.0,
+        bounces: isr::bounces::Bounces::ONE,
     };
     let (a, b) = (
         isr::pathtrace::render(&far, &settings, |_, _| {}),
@@ -369,6 +370,7 @@ fn the_path_tracer_renders_a_box_2e_minus_6_m_across_as_at_home() {
         spp: 4,
         seed: 1,
         exposure: 1.0,
+        bounces: isr::bounces::Bounces::ONE,
     };
     let (a, b) = (
         isr::pathtrace::render(&home, &settings, |_, _| {}),

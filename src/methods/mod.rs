@@ -292,14 +292,20 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
     d.write_uniforms(s, u);
 }
 
-/// Every parameter of every method, once each, in registry order.
+/// Parameters of a run that no method here reads yet but every command
+/// takes: `--bounces`, which the path tracer and the bench's truth read
+/// (`bounces`). Set for a method that does not read it, it is warned of as
+/// any parameter the method does not read (`unused_params`).
+pub const RUN_PARAMS: &[&dyn AnyParam] = &[&crate::bounces::BOUNCES];
+
+/// Every parameter of every method, once each, in registry order, then
+/// those of [`RUN_PARAMS`] no method reads.
 pub fn all_params() -> Vec<&'static dyn AnyParam> {
     let mut out: Vec<&'static dyn AnyParam> = vec![];
-    for &d in REGISTRY {
-        for p in params_of(d) {
-            if !out.iter().any(|q| q.name() == p.name()) {
-                out.push(p);
-            }
+    let of_methods = REGISTRY.iter().flat_map(|&d| params_of(d));
+    for p in of_methods.chain(RUN_PARAMS.iter().copied()) {
+        if !out.iter().any(|q| q.name() == p.name()) {
+            out.push(p);
         }
     }
     out
