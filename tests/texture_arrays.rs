@@ -195,6 +195,7 @@ fn each_texture_of_many_sizes_shows_where_it_is_mapped() {
             spp: 1,
             seed: 1,
             exposure: 1.0,
+            bounces: isr::bounces::Bounces::ONE,
         },
         |_, _| {},
     );
@@ -232,8 +233,9 @@ fn a_texture_wider_than_a_layer_renders_shrunk_with_a_warning() {
         .succeeds();
     assert!(
         ran.stderr.contains(
-            "warning: texture image 0 (unnamed) is 4100x2; texture layers are at most \
-                       4096x4096 on every device, so it is shrunk to 4096x2"
+            "warning: texture layers are at most 4096x4096 on every device, so 1 texture(s) \
+             are shrunk to fit (averaged in linear light): texture image 0 (unnamed) is \
+             4100x2, shrunk to 4096x2"
         ),
         "{}",
         ran.stderr
