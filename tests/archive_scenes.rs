@@ -160,6 +160,10 @@ fn each_archive_obj_renders_a_hisr_frame_lit_and_framed_from_the_command_line() 
         // The command line's light and camera replaced the defaults.
         assert!(!ran.stderr.contains("default spot light"), "{}", ran.stderr);
         assert!(!ran.stderr.contains("default camera"), "{}", ran.stderr);
+        // Every texture is sampled as it is: none replaced by its mean
+        // colour, none shrunk.
+        assert!(!ran.stderr.contains("mean colour"), "{}", ran.stderr);
+        assert!(!ran.stderr.contains("shrunk"), "{}", ran.stderr);
         let img = image::open(&png).unwrap().to_rgb8();
         let bright = img
             .pixels()
