@@ -36,7 +36,8 @@ fn textures_of_few_sizes_get_an_array_of_their_own_size_each() {
         solid("c", 64, 32),
         solid("d", 3, 5),
     ];
-    let plan = TexturePlan::new(&textures).unwrap();
+    // No padding allowed: no join past the arrays' number.
+    let plan = TexturePlan::with_padding(&textures, 0).unwrap();
     assert_consistent(&plan, &textures);
     let sizes: Vec<(u32, u32, usize)> = plan
         .arrays
@@ -46,6 +47,11 @@ fn textures_of_few_sizes_get_an_array_of_their_own_size_each() {
     assert_eq!(sizes, [(3, 5, 1), (16, 16, 1), (64, 32, 2)]);
     // Nothing is padded: the arrays hold exactly the textures' texels.
     assert_eq!(plan.bytes(), (64 * 32 * 2 + 16 * 16 + 3 * 5) * 4);
+    // With the default padding, so few texels join into one array.
+    let one = TexturePlan::new(&textures).unwrap();
+    assert_consistent(&one, &textures);
+    assert_eq!(one.arrays.len(), 1);
+    assert_eq!((one.arrays[0].width, one.arrays[0].height), (66, 34));
     assert_eq!(
         TexturePlan::new(&[]).unwrap().arrays,
         Vec::<ArrayPlan>::new()
@@ -72,7 +78,7 @@ fn more_sizes_than_arrays_join_the_groups_that_add_fewest_texels() {
         .iter()
         .map(|&(w, h)| solid(&format!("{w}x{h}"), w, h))
         .collect();
-    let plan = TexturePlan::new(&textures).unwrap();
+    let plan = TexturePlan::with_padding(&textures, 0).unwrap();
     assert_consistent(&plan, &textures);
     assert_eq!(plan.arrays.len(), ARRAYS);
     let own: u64 = sizes.iter().map(|&(w, h)| w as u64 * h as u64 * 4).sum();
@@ -87,6 +93,18 @@ fn more_sizes_than_arrays_join_the_groups_that_add_fewest_texels() {
     assert_eq!((a(2).width, a(2).height), (155, 23));
     assert_eq!(a(5), a(4));
     assert_eq!(a(0), a(6));
+    // By default Sponza's 2.1 M texels may add 16 M: one array of ten
+    // bordered 1026x809 layers.
+    let one = TexturePlan::new(&textures).unwrap();
+    assert_consistent(&one, &textures);
+    assert_eq!(one.arrays.len(), 1);
+    assert_eq!(one.bytes(), 1026 * 809 * 10 * 4);
+    // Padding of at most the textures' own 2.1 M texels: 4 arrays of 12.1
+    // MiB in all (3 would take 16.1 MiB, over the 16.0 allowed).
+    let four = TexturePlan::with_padding(&textures, own / 4).unwrap();
+    assert_consistent(&four, &textures);
+    assert_eq!(four.arrays.len(), 4);
+    assert!(four.bytes() - own <= own, "{}", four.bytes());
 }
 
 #[test]
