@@ -154,9 +154,9 @@ fn albedo_errors(
 /// texture (white times the texture) sampled at the pixel's point, within
 /// 0.01: the device's sRGB decoding and filtering, the 16-bit float albedo
 /// target and the rounding of the point's texture coordinates (a wrong
-/// texel is off by tenths). The arrays are at most eight; some textures
-/// fill their layers (the sampler filters them) and some sit in larger
-/// ones (the shader filters them).
+/// texel is off by tenths). The arrays are at most eight; the texture
+/// shrunk to 4096 wide fills its layer, and the others sit bordered in
+/// larger ones (the sampler's taps across their edges read the border).
 #[test]
 fn each_texture_of_many_sizes_shows_where_it_is_mapped() {
     let scene = squares();
