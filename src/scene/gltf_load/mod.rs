@@ -244,6 +244,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             l.intensity
         ));
         out.lights = vec![l];
+        out.bare.light = true;
     } else {
         bound.lights = lights.iter().map(|&(node, _)| node).collect();
         out.lights = lights.into_iter().map(|(_, l)| l).collect();
@@ -255,6 +256,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         }
         None => {
             out.camera = fitted_camera(lo, hi);
+            out.bare.camera = true;
             warnings.push(
                 "no perspective camera: using a default camera on +Z looking at the scene's center"
                     .into(),
