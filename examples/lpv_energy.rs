@@ -5,10 +5,18 @@
 //! same size until its noise is under 3% (minutes a scene on lavapipe's
 //! CPUs; every point shares it).
 //!
-//!     cargo run --release --example lpv_energy [-- [--scenes a,b] [POINT...]]
+//!     cargo run --release --example lpv_energy [-- [--scenes a,b] [--scale S] [--out DIR] [POINT...]]
 //!
 //! `--scenes` names bench scenes (default: the stress scenes and `bunny`,
-//! whose mesh is read from the archive folder, `../shared/scenes`). A POINT
+//! whose mesh is read from the archive folder, `../shared/scenes`);
+//! `--scale` scales every scene by S about the world's origin (camera,
+//! lights and znear with it; default 1): a room like it of another size,
+//! since LPV's cells are powers of two and a room fills them differently
+//! within an octave (the ratios do not depend on the light's intensity, so
+//! it is left as it is); `--out`
+//! writes, per scene and point, `DIR/SCENE-K.png`: the truth's indirect
+//! irradiance on the left, point K's on the right, both grey, white at four
+//! times the truth's mean (to see where the light goes). A POINT
 //! is LPV's parameters as `name=value` pairs joined by commas
 //! (`lpv-size=16,lpv-iterations=16`); `default` is the method's defaults,
 //! and the only point when none is given.
@@ -20,12 +28,14 @@
 //! taken out, `Truth::model_error`).
 
 use anyhow::{bail, Context as _, Result};
+use glam::{Mat4, Vec3};
 use isr::bench::truth::{trace, ShadowMaps, Truth};
 use isr::methods::lpv::{self, grid, Layout};
 use isr::renderer::Renderer;
 use isr::scene::Scene;
 use isr::settings::{Params, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
+use std::path::PathBuf;
 
 /// The truth's noise target (relative RMSE of its indirect image): small
 /// beside LPV's errors, and far smaller in a sum over the image.
@@ -42,6 +52,23 @@ fn default_scenes() -> Vec<String> {
         .collect();
     v.push("bunny".into());
     v
+}
+
+/// `scene` scaled by `s` about the origin: its instances, camera, znear and
+/// lights (the camera's node stays rigid, its position scaled).
+fn scaled(mut scene: Scene, s: f32) -> Scene {
+    let m = Mat4::from_scale(Vec3::splat(s));
+    for i in &mut scene.instances {
+        i.world_from_object = m * i.world_from_object;
+    }
+    let c = &mut scene.camera;
+    c.world_from_camera.w_axis = (c.world_from_camera.w_axis.truncate() * s).extend(1.0);
+    c.znear *= s;
+    for l in &mut scene.lights {
+        l.position *= s;
+        l.range = l.range.map(|r| r * s);
+    }
+    scene
 }
 
 /// A point's parameters from `name=value,...` (`default`: none).
@@ -91,6 +118,32 @@ fn compare(t: &Truth, position: &[[f32; 4]], indirect: &[[f32; 4]]) -> (f64, f64
     (lpv / truth, t.model_error(indirect))
 }
 
+/// The truth's and LPV's indirect irradiance side by side, grey (the sum
+/// of the channels), white at four times the truth's mean over `position`'s
+/// geometry, as an RGBA8 image twice as wide as the frame.
+fn side_by_side(t: &Truth, position: &[[f32; 4]], indirect: &[[f32; 4]]) -> Vec<u8> {
+    let sum = |e: &[f32; 4]| e[0] + e[1] + e[2];
+    let seen: Vec<f32> = position
+        .iter()
+        .zip(&t.image.indirect)
+        .filter(|(p, _)| p[3] > 0.0)
+        .map(|(_, e)| sum(e))
+        .collect();
+    let white = 4.0 * seen.iter().sum::<f32>() / seen.len().max(1) as f32;
+    let grey = |e: &[f32; 4]| {
+        let v = (sum(e) / white).clamp(0.0, 1.0).powf(1.0 / 2.2);
+        let g = (v * 255.0).round() as u8;
+        [g, g, g, 255]
+    };
+    let w = t.image.width as usize;
+    let mut out = vec![];
+    for (a, b) in t.image.indirect.chunks(w).zip(indirect.chunks(w)) {
+        out.extend(a.iter().flat_map(grey));
+        out.extend(b.iter().flat_map(grey));
+    }
+    out
+}
+
 /// Where the cascades lie this frame, for the table: each one's cell size.
 fn cells(r: &Renderer, s: &RenderSettings) -> String {
     let c = grid::cascades(&r.frame_uniforms(), &Layout::of(s));
@@ -101,11 +154,17 @@ fn cells(r: &Renderer, s: &RenderSettings) -> String {
 fn main() -> Result<()> {
     let mut scenes = default_scenes();
     let mut points = vec![];
+    let mut out: Option<PathBuf> = None;
+    let mut scale = 1.0f32;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if a == "--scenes" {
             let value = args.next().context("--scenes takes a value")?;
             scenes = value.split(',').map(str::to_string).collect();
+        } else if a == "--scale" {
+            scale = args.next().context("--scale takes a number")?.parse()?;
+        } else if a == "--out" {
+            out = Some(args.next().context("--out takes a folder")?.into());
         } else {
             points.push((a.clone(), point(&a)?));
         }
@@ -115,7 +174,8 @@ fn main() -> Result<()> {
     }
     let gpu = Gpu::new(&GpuOptions::default())?;
     println!(
-        "LPV against the one-bounce truth, {SIZE}x{SIZE}, RSM {SIZE}, at rest ({}, {})\n",
+        "LPV against the one-bounce truth, {SIZE}x{SIZE}, RSM {SIZE}, at rest, scenes scaled by \
+         {scale} ({}, {})\n",
         gpu.info.name, gpu.info.driver
     );
     println!(
@@ -123,27 +183,32 @@ fn main() -> Result<()> {
     );
     println!("| --- | --- | --- | --- | ---: | ---: | ---: |");
     for name in &scenes {
-        let mut scene: Scene = isr::bench::scenes::build(name)?;
+        let mut scene = scaled(isr::bench::scenes::build(name)?, scale);
         scene.animation = None;
         let mut truth: Option<Truth> = None;
-        for (text, params) in &points {
+        for (k, (text, params)) in points.iter().enumerate() {
             let s = settings(params);
             isr::methods::find(lpv::KEY)?.check(&s)?;
             let mut r = Renderer::new(&gpu, &scene, &s)?;
             r.render_frames(1, |_| {})?;
-            let out = r.readback()?;
+            let image = r.readback()?;
             let t = match &truth {
                 Some(t) => t,
                 None => {
                     eprintln!("{name}: tracing the truth");
                     let shadows =
                         ShadowMaps::new(r.light_views(), r.render_origin(), SIZE, s.pcf_radius);
-                    truth.insert(trace(&scene, &out, &shadows, NOISE, 1, |spp, noise| {
+                    truth.insert(trace(&scene, &image, &shadows, NOISE, 1, |spp, noise| {
                         eprintln!("{name}: {spp} spp, noise {noise:.4}")
                     }))
                 }
             };
-            let (ratio, error) = compare(t, &out.position, &out.indirect);
+            let (ratio, error) = compare(t, &image.position, &image.indirect);
+            if let Some(dir) = &out {
+                let png = side_by_side(t, &image.position, &image.indirect);
+                let path = dir.join(format!("{name}-{k}.png"));
+                isr::output::write_png(&path, 2 * SIZE, SIZE, &png)?;
+            }
             let label = isr::methods::find(lpv::KEY)?.label(&s);
             println!(
                 "| {name} | {text} | {label} | {} | {ratio:.3} | {error:.3} | {}, {:.4} |",
