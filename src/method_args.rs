@@ -7,8 +7,10 @@
 //! against their ranges with the other settings (`methods::check`).
 
 use crate::methods::{all_params, params_of, REGISTRY};
+use crate::passes::rsm_tree;
 use crate::settings::params::AnyParam;
 use crate::settings::{Params, Value};
+use crate::{multires, regular_vpls, visibility};
 
 /// The parameters given on the command line (the others keep their defaults).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -16,21 +18,62 @@ pub struct ParamArgs(pub Params);
 
 /// `--help`'s text for `p`: its help, default, range and the methods that read it.
 fn help_text(p: &dyn AnyParam) -> String {
-    let readers: Vec<&str> = REGISTRY
-        .iter()
-        .filter(|d| params_of(**d).any(|q| q.name() == p.name()))
-        .map(|d| d.key().name())
-        .collect();
+    let readers = readers(p);
     let range = match *p.range() {
         r if r == crate::settings::Range::ANY => String::new(),
         r => format!("; {}", r.describe()),
     };
+    // A run parameter no method reads yet says who does in its help.
+    let readers = match readers.is_empty() {
+        true => String::new(),
+        false => format!(" [methods: {}]", readers.join(", ")),
+    };
     format!(
-        "{}. [default: {}{range}] [methods: {}]",
+        "{}. [default: {}{range}]{readers}",
         p.help(),
-        p.default_text(),
-        readers.join(", ")
+        p.default_text()
     )
+}
+
+/// The methods that read `p`, in registry order.
+fn readers(p: &dyn AnyParam) -> Vec<&'static str> {
+    REGISTRY
+        .iter()
+        .filter(|d| params_of(**d).any(|q| q.name() == p.name()))
+        .map(|d| d.key().name())
+        .collect()
+}
+
+/// The heading `p` is listed under in `--help`: the shared layer that
+/// declares it (with the methods that read it), or the method whose own
+/// parameter it is.
+fn heading(p: &dyn AnyParam) -> String {
+    let has = |list: &[&dyn AnyParam]| list.iter().any(|q| q.name() == p.name());
+    let shared = if has(visibility::PARAMS) {
+        Some("Indirect visibility")
+    } else if has(multires::PARAMS) {
+        Some("Eye-space hierarchy")
+    } else if has(regular_vpls::PARAMS) {
+        Some("Regular VPLs")
+    } else if has(rsm_tree::PARAMS) {
+        Some("RSM quadtree")
+    } else {
+        None
+    };
+    let readers = readers(p);
+    match shared {
+        Some(what) => format!("{what} ({})", readers.join(", ")),
+        None => format!("--method {}", readers.first().copied().unwrap_or("?")),
+    }
+}
+
+/// Whether `-h` shows `p`: a method's main knob, or the visibility choice;
+/// `--help` shows every parameter, the ablation knobs too.
+pub fn in_short_help(p: &dyn AnyParam) -> bool {
+    p.name() == visibility::VISIBILITY.name
+        || REGISTRY
+            .iter()
+            .any(|d| d.main_param().is_some_and(|q| q.name() == p.name()))
 }
 
 /// [`ParamArgs`] but for `--visibility`: `isr bench` takes a list there
@@ -96,8 +139,10 @@ fn augment(mut cmd: clap::Command, except: &[&str]) -> clap::Command {
             clap::Arg::new(p.name())
                 .long(p.name())
                 .value_name(p.value_name())
-                .help(help_text(p))
-                .help_heading("Method parameters")
+                .help(format!("{} [default: {}]", p.help(), p.default_text()))
+                .long_help(help_text(p))
+                .help_heading(heading(p))
+                .hide_short_help(!in_short_help(p))
                 .allow_negative_numbers(true)
                 .value_parser(move |text: &str| p.parse(text)),
         );

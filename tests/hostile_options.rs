@@ -180,17 +180,21 @@ fn numeric_options(command: &str) -> Vec<String> {
             "device",
         ],
     };
-    let help = Isr::new(command).arg("--help").succeeds().stdout;
-    let params = help
-        .split("Method parameters:")
-        .nth(1)
-        .unwrap_or_else(|| panic!("no method parameters in isr {command} --help"));
+    // Every method parameter that takes a number (`<N>`; choices and
+    // switches take words), whichever heading --help lists it under.
     let mut options: Vec<String> = own.iter().map(|s| s.to_string()).collect();
-    for line in params.lines() {
-        // Options start their lines at clap's indent; help text is deeper.
-        if let Some(rest) = line.strip_prefix("      --") {
-            options.push(rest.split(' ').next().unwrap().to_string());
-        }
+    options.extend(
+        isr::methods::all_params()
+            .into_iter()
+            .filter(|p| p.value_name() == "N")
+            .map(|p| p.name().to_string()),
+    );
+    let help = Isr::new(command).arg("--help").succeeds().stdout;
+    for o in &options {
+        assert!(
+            help.contains(&format!("--{o}")),
+            "isr {command} --help lacks --{o}"
+        );
     }
     assert!(options.len() > own.len() + 5, "{options:?}");
     options
@@ -249,11 +253,14 @@ fn every_numeric_option_takes_values_with_a_minus_sign() {
     assert!(e.contains("--exposure") && e.contains("finite"), "{e}");
 }
 
-/// `name`'s render with `alone` says `warning`; with `--visibility voxels`
-/// added it says nothing of the kind.
+/// `name`'s render with `alone` and `--visibility none` says `warning`; with
+/// `--visibility voxels` (the default) it says nothing of the kind.
 fn warns_only_without_voxels(name: &str, alone: &[&str], warning: &str) {
     let dir = temp_dir(name);
-    let ran = Isr::tiny(&dir).args(alone).succeeds();
+    let ran = Isr::tiny(&dir)
+        .args(alone)
+        .args(["--visibility", "none"])
+        .succeeds();
     assert!(ran.stderr.contains(warning), "{}", ran.stderr);
     let ran = Isr::tiny(&dir)
         .args(alone)
@@ -305,6 +312,8 @@ fn shared_visibility_without_the_grid_is_named_as_having_no_effect() {
         );
     }
     let dir = temp_dir("sharing-default");
-    let ran = Isr::tiny(&dir).args(["--method", "hisr"]).succeeds();
+    let ran = Isr::tiny(&dir)
+        .args(["--method", "hisr", "--visibility", "none"])
+        .succeeds();
     assert!(!ran.stderr.contains("has no effect"), "{}", ran.stderr);
 }

@@ -425,6 +425,12 @@ fn hisr_tile_cuts_decide_like_a_traversal_from_the_roots() {
             // Levels 0-4: with K = 1 the cut levels' tiles are 2, 4 and 8
             // pixels a side, and level 4's patches are coarser than all.
             .with(&isr::multires::LEVELS, 4)
+            // Without the grid: its tile-shared visibility interpolates the
+            // tiles' corners, which a walk from the roots does not.
+            .with(
+                &isr::visibility::VISIBILITY,
+                isr::visibility::Visibility::None,
+            )
         };
         let tiled = with(tile_level);
         if tau < 1e-3 {

@@ -179,19 +179,25 @@ fn timings_json_from_the_cli_lists_every_pass() {
     assert_eq!(v["frames"], 3);
     let passes = v["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    // The default method, multires-gather, adds its indirect passes between
-    // direct light and the composite.
+    // The default method, HISR with the voxel grid, adds its indirect
+    // passes: the grid after the G-buffer (it needs only the posed scene),
+    // the rest between direct light and the composite.
     let indirect = [
+        "voxel-grid",
         "rsm-tree",
         "geometry-mips",
         "stencil-refine",
-        "vpl-list",
+        "light-tree-pack",
+        "hisr-cut",
+        "hisr-visibility",
         "gather",
         "upsample",
     ];
-    let expected: Vec<&str> = PASSES[..3]
+    let expected: Vec<&str> = PASSES[..2]
         .iter()
-        .chain(&indirect)
+        .chain(&indirect[..1])
+        .chain(&PASSES[2..3])
+        .chain(&indirect[1..])
         .chain(&PASSES[3..])
         .copied()
         .collect();

@@ -4,12 +4,14 @@
 //! `report.md` into one folder. Rows are journalled to `rows.jsonl` as they
 //! finish, so an interrupted run resumes where it stopped.
 
+pub mod bounces;
 pub mod charts;
 pub mod files;
 pub mod flip;
 pub mod gallery;
 mod measure;
 pub mod metrics;
+pub mod publish;
 pub mod ratios;
 pub mod report;
 pub mod rows;
@@ -80,6 +82,12 @@ pub struct BenchArgs {
     /// Vulkan device index (`isr devices`).
     #[arg(long)]
     pub device: Option<usize>,
+    /// After the run, publish it into the repository at ROOT: its report as
+    /// ROOT/docs/results.md (charts, gallery and rows in ROOT/docs/results/)
+    /// and its headline tables into ROOT/README.md, between the markers
+    /// there (`--publish .` from the repository's root).
+    #[arg(long, value_name = "ROOT")]
+    pub publish: Option<PathBuf>,
     /// Parameters every point renders with, where its sweep does not set
     /// them (`--levels 4`: every multiresolution method at 4 levels).
     #[command(flatten)]
@@ -101,6 +109,7 @@ impl Default for BenchArgs {
             truth_noise: None,
             visibility: vec![],
             device: None,
+            publish: None,
             params: Default::default(),
         }
     }
@@ -267,9 +276,14 @@ impl BenchArgs {
         // Each pass sets its own (`Plan::passes`); a grid out of range is
         // refused before any work.
         let base = visibility::with(&base, Visibility::None);
+        use crate::settings::params::AnyParam as _;
         if visibilities.contains(&Visibility::Voxels) {
-            use crate::settings::params::AnyParam as _;
             crate::voxel_grid::GRID.check(&base)?;
+        }
+        // The truth's bounces, refused out of range before any work.
+        crate::bounces::BOUNCES.check(&base)?;
+        if let Some(w) = bounces::warning(&base).filter(|_| truth_noise > 0.0) {
+            eprintln!("{w}");
         }
         Ok(Plan {
             scenes: specs,
@@ -314,19 +328,21 @@ impl Plan {
             .truth_noise
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         // With the voxel grid on (`--visibility voxels`), rows are kept
-        // apart from a run's without it, so both can share a directory.
+        // apart from a run's without it, so both can share a directory; so
+        // are rows against a truth of more than one bounce.
         let visibility = match crate::visibility::uses_voxels(b) {
             true => format!("|{}", visibility::label(b)),
             false => String::new(),
         };
         format!(
-            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}{visibility}",
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}{visibility}{}",
             b.width,
             b.height,
             b.rsm_resolution,
             self.frames,
             self.timing_frames,
-            metrics::FLICKER_MEASURE
+            metrics::FLICKER_MEASURE,
+            bounces::key_suffix(b)
         )
     }
 
@@ -356,6 +372,10 @@ pub struct Outcome {
     pub rows: Vec<Row>,
     pub device: String,
     pub driver: String,
+    /// The command that ran (`isr bench ...`), and the day it finished
+    /// (UTC, YYYY-MM-DD): what the published results name.
+    pub command: String,
+    pub date: String,
 }
 
 /// The images of `spec` that the gallery shows, written by
@@ -480,6 +500,8 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
         rows,
         device: gpu.info.name.clone(),
         driver: gpu.info.driver.clone(),
+        command: command_line(),
+        date: today(),
     };
     report::write_all(plan, &outcome)?;
     Ok(outcome)
@@ -488,13 +510,76 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
 /// `isr bench`: plans, runs, prints where the results are and the ratios.
 pub fn cli(args: &BenchArgs) -> Result<()> {
     let plan = args.plan()?;
+    if let Some(root) = &args.publish {
+        // Checked before the run, not after an hour of it.
+        let readme = std::fs::read_to_string(root.join("README.md")).map_err(|e| {
+            anyhow::anyhow!(
+                "--publish {}: no README.md to publish into ({e})",
+                root.display()
+            )
+        })?;
+        if publish::block(&readme).is_none() {
+            bail!(
+                "--publish {}: README.md has no block between {} and {} for the headline tables",
+                root.display(),
+                publish::BEGIN,
+                publish::END
+            );
+        }
+    }
     let outcome = run(&plan)?;
     println!("{}", ratios::ratios_text(&ratios::ratios(&outcome.rows)));
     println!("wrote {} to {}", files::summary(), plan.out_dir.display());
+    if let Some(root) = &args.publish {
+        publish::publish(&plan, &outcome, root)?;
+    }
     Ok(())
+}
+
+/// The command line this process was started with, as `isr bench ...`.
+fn command_line() -> String {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    format!("isr {}", args.join(" "))
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the system clock.
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// The proleptic Gregorian date of `days` since 1970-01-01 (Howard
+/// Hinnant's days-to-civil algorithm).
+fn civil_from_days(days: i64) -> (i64, u32, u32) {
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    (yoe + era * 400 + (m <= 2) as i64, m, d)
 }
 
 /// Animation time of frame `k`.
 fn frame_time(spec: &SceneSpec, k: u32) -> f32 {
     spec.start + k as f32 / spec.fps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::civil_from_days;
+
+    #[test]
+    fn days_become_dates() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(59), (1970, 3, 1));
+        // 2000-02-29 (a leap day of a year divisible by 400) and 2026-12-06.
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(20_793), (2026, 12, 6));
+    }
 }

@@ -54,16 +54,10 @@ pub fn default(quick: bool) -> Vec<Visibility> {
     }
 }
 
-/// `s` with visibility `v`. `none` leaves the parameter unset, so that its
-/// rows' parameters and journal keys are those of runs before the axis.
+/// `s` with visibility `v`, set explicitly whatever the default.
 pub fn with(s: &RenderSettings, v: Visibility) -> RenderSettings {
     let mut s = s.clone();
-    match v {
-        Visibility::None => {
-            s.params.0.remove(VISIBILITY.name);
-        }
-        v => VISIBILITY.set(&mut s, v),
-    }
+    VISIBILITY.set(&mut s, v);
     s
 }
 

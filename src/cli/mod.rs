@@ -54,49 +54,64 @@ struct RenderArgs {
     run: RunArgs,
     /// Frames to render; timings are medians over them (over all but the last,
     /// which alone counts fragments and invocations, when there are several).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100_000), help_heading = "Size")]
     frames: u32,
     /// Multi-layer OpenEXR output (linear).
-    #[arg(long, default_value = "out/render.exr")]
+    #[arg(long, default_value = "out/render.exr", help_heading = "Output")]
     out: PathBuf,
     /// PNG output (tonemapped sRGB).
-    #[arg(long, default_value = "out/render.png")]
+    #[arg(long, default_value = "out/render.png", help_heading = "Output")]
     png: PathBuf,
     /// Write per-pass GPU timings as JSON to this file.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     timings: Option<PathBuf>,
     /// Print patch counts per level (also recorded in the timings JSON).
-    #[arg(long)]
+    #[arg(long, help_heading = "Output", hide_short_help = true)]
     stats: bool,
     /// Indirect samples per pixel for --method pathtrace.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536), help_heading = "--method pathtrace")]
     spp: u32,
     /// Random seed for --method pathtrace.
-    #[arg(long, default_value_t = 1)]
+    #[arg(
+        long,
+        default_value_t = 1,
+        help_heading = "--method pathtrace",
+        hide_short_help = true
+    )]
     seed: u64,
     /// Extra PNGs next to --png: `levels` colors each pixel by the level of its
     /// patch, `indirect` shows the indirect light alone, `vpl-count` is a heat
     /// map of the light patches evaluated per pixel. Repeatable.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, help_heading = "Output", hide_short_help = true)]
     debug_view: Vec<DebugView>,
     /// Write --frames frames at times --time + k / --fps into this folder
     /// (frame_0000.exr, frame_0000.png, ..., timings.json) instead of timing
     /// one frame --frames times.
-    #[arg(long)]
+    #[arg(long, help_heading = "Animation")]
     sequence: Option<PathBuf>,
     /// Frames per second of a --sequence.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(
+        long,
+        default_value_t = 30.0,
+        help_heading = "Animation",
+        hide_short_help = true
+    )]
     fps: f32,
     /// With --sequence, also write the frames as a looping animated GIF,
     /// DIR/sequence.gif, played at --fps.
-    #[arg(long, requires = "sequence")]
+    #[arg(
+        long,
+        requires = "sequence",
+        help_heading = "Animation",
+        hide_short_help = true
+    )]
     gif: bool,
     /// Circle the light about the scene's vertical axis through its initial
     /// position, once per PERIOD seconds, still aimed at the same point.
-    #[arg(long, value_name = "PERIOD")]
+    #[arg(long, value_name = "PERIOD", help_heading = "Animation")]
     orbit_light: Option<f32>,
     /// The same for the camera.
-    #[arg(long, value_name = "PERIOD")]
+    #[arg(long, value_name = "PERIOD", help_heading = "Animation")]
     orbit_camera: Option<f32>,
 }
 
@@ -177,6 +192,12 @@ enum DebugView {
 }
 
 /// Parses `std::env::args` and runs the command.
+/// The `isr` command line as clap describes it: every command and option
+/// (the docs' tests check guide.md against it).
+pub fn command() -> clap::Command {
+    <Cli as clap::CommandFactory>::command()
+}
+
 pub fn run() -> Result<()> {
     let cli = parse();
     interrupt::install()?;
@@ -304,7 +325,9 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let mut scene = run.load_scene()?;
     let Some(descriptor) = gpu_method else {
-        for name in run.params.0 .0.keys() {
+        // Of the parameters, the path tracer reads the bounces alone.
+        let bounces = crate::bounces::BOUNCES.name;
+        for name in run.params.0 .0.keys().filter(|&&n| n != bounces) {
             eprintln!("warning: --method pathtrace does not read --{name}; it has no effect");
         }
         // The CPU reference renders the scene posed at --time.

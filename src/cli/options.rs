@@ -52,12 +52,16 @@ pub struct RunArgs {
     /// and textures) or a scene description naming either with lights,
     /// camera and motion (NAME.scene.json; README, "Scenes from the
     /// archives"); the built-in Cornell box when omitted.
-    #[arg(long)]
+    #[arg(long, help_heading = "Scene, lights and camera")]
     pub scene: Option<PathBuf>,
     /// Let the scene's files (buffers, images, an OBJ's MTL and textures, a
     /// description's mesh) be outside its folder (absolute paths, '..',
     /// file: URIs, symbolic links out of it).
-    #[arg(long)]
+    #[arg(
+        long,
+        help_heading = "Scene, lights and camera",
+        hide_short_help = true
+    )]
     pub allow_outside_uris: bool,
     /// A light instead of the scene's (repeat for several):
     /// `spot:position=X,Y,Z:target=X,Y,Z[:cone=DEG][:inner=DEG][:intensity=CD][:color=R,G,B][:range=M]`,
@@ -67,39 +71,44 @@ pub struct RunArgs {
     /// (or the scene's centre) facing the light reflect radiance 1; the cone
     /// (outer half-angle) to 45 degrees, the inner to 3/4 of it. Move it with
     /// --orbit-light, or give it a path in a scene description.
-    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_light)]
+    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_light, help_heading = "Scene, lights and camera")]
     pub light: Vec<crate::scene::description::LightSpec>,
     /// The camera instead of the scene's:
     /// `position=X,Y,Z[:target=X,Y,Z][:fov=DEG][:znear=M]` (target default:
     /// the scene's centre; fov vertical, default 45; znear default 1/1000 of
     /// the scene's diagonal). Move it with --orbit-camera.
-    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_camera)]
+    #[arg(long, value_name = "SPEC", value_parser = crate::scene::description::parse_camera, help_heading = "Scene, lights and camera")]
     pub camera: Option<crate::scene::description::CameraSpec>,
     /// How indirect light is computed.
-    #[arg(long, value_parser = method_parser(), default_value = D.method.name())]
+    #[arg(long, value_parser = method_parser(), default_value = D.method.name(), help_heading = "Method")]
     pub method: MethodArg,
     /// Output width in pixels.
-    #[arg(long, default_value_t = D.width)]
+    #[arg(long, default_value_t = D.width, help_heading = "Size")]
     pub width: u32,
     /// Output height in pixels.
-    #[arg(long, default_value_t = D.height)]
+    #[arg(long, default_value_t = D.height, help_heading = "Size")]
     pub height: u32,
     /// Reflective shadow map resolution R (R x R, a power of two).
-    #[arg(long, default_value_t = D.rsm_resolution)]
+    #[arg(long, default_value_t = D.rsm_resolution, help_heading = "Size")]
     pub rsm: u32,
     /// Multiplier on radiance before the PNG's sRGB encoding.
-    #[arg(long, default_value_t = D.exposure)]
+    #[arg(long, default_value_t = D.exposure, help_heading = "Output")]
     pub exposure: f32,
     /// Animation time in seconds: the scene's glTF animations (and the
     /// --orbit-* motion) at this time. With --sequence, the first frame's time.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_negative_numbers = true,
+        help_heading = "Animation"
+    )]
     pub time: f32,
     /// Load the Khronos validation layer with synchronization validation; exit
     /// non-zero if it reports anything.
-    #[arg(long)]
+    #[arg(long, help_heading = "Device", hide_short_help = true)]
     pub validate: bool,
     /// Device index from `isr devices` (default: discrete > integrated > virtual > CPU).
-    #[arg(long)]
+    #[arg(long, help_heading = "Device", hide_short_help = true)]
     pub device: Option<usize>,
     #[command(flatten)]
     pub params: ParamArgs,

@@ -16,14 +16,23 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
     if args.spp == 0 {
         bail!("--spp must be at least 1");
     }
+    use crate::settings::params::AnyParam as _;
+    let bounces = &crate::bounces::BOUNCES;
+    let settings = crate::settings::RenderSettings {
+        params: run.params.0.clone(),
+        ..crate::settings::RenderSettings::DEFAULT
+    };
+    bounces.check(&settings)?;
+    let bounces = bounces.get(&settings);
     let threads = rayon::current_num_threads();
     eprintln!(
-        "path tracing {} ({} triangles) at {}x{}, {} spp, on {threads} CPU threads",
+        "path tracing {} ({} triangles) at {}x{}, {} spp, {}, on {threads} CPU threads",
         scene.name,
         scene.triangle_count(),
         run.width,
         run.height,
-        args.spp
+        args.spp,
+        bounces.words()
     );
     let started = std::time::Instant::now();
     let bar = crate::progress::bar(run.height as u64, "rows");
@@ -35,6 +44,7 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
             spp: args.spp,
             seed: args.seed,
             exposure: run.exposure,
+            bounces,
         },
         |done, _rows| bar.set_position(done as u64),
     );
@@ -110,8 +120,18 @@ pub(super) fn sequence(
         let t = args.run.time + k as f32 / args.fps;
         renderer.update(&args.state_at(scene, t)?)?;
         // Each frame is its own run of one frame: its images are read back
-        // before the next one changes the scene.
-        let stats = renderer.render_frames(1, |_| {}).map_err(|e| {
+        // and written before the next one changes the scene. Whatever of it
+        // fails (the frame, its readback, its files) names what is kept.
+        let exr = dir.join(format!("frame_{k:04}.exr"));
+        let png = dir.join(format!("frame_{k:04}.png"));
+        let frame = (|| -> Result<(crate::renderer::FrameStats, Vec<u8>)> {
+            let stats = renderer.render_frames(1, |_| {})?;
+            let result = renderer.readback()?;
+            output::write_exr(&exr, &result)?;
+            output::write_png(&png, result.width, result.height, &result.display)?;
+            Ok((stats, result.display))
+        })();
+        let (stats, display) = frame.map_err(|e| {
             bar.abandon();
             e.context(format!(
                 "rendering frame {k} (t = {t} s) failed; {}timings.json was not written",
@@ -126,11 +146,6 @@ pub(super) fn sequence(
                 }
             ))
         })?;
-        let result = renderer.readback()?;
-        let exr = dir.join(format!("frame_{k:04}.exr"));
-        let png = dir.join(format!("frame_{k:04}.png"));
-        output::write_exr(&exr, &result)?;
-        output::write_png(&png, result.width, result.height, &result.display)?;
         super::interrupt::set_note(format!(
             "{} in {} complete; timings.json was not written",
             match k {
@@ -140,7 +155,7 @@ pub(super) fn sequence(
             dir.display()
         ));
         if args.gif {
-            gif_frames.push(result.display);
+            gif_frames.push(display);
         }
         let mut r = args.report(gpu, scene, &stats);
         r.time = Some(t);

@@ -117,8 +117,9 @@ pub fn assert_validation_clean(gpu: &Gpu) {
 
 // Rendering.
 
-/// `method` at `width` x `height` with an RSM of `rsm`, every other setting
-/// the default.
+/// `method` at `width` x `height` with an RSM of `rsm` in the paper's model
+/// (`--visibility none`: the CPU sums the tests hold the GPU to have no
+/// occlusion; a test of the grid sets it), every other setting the default.
 pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderSettings {
     RenderSettings {
         width,
@@ -127,6 +128,10 @@ pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderS
         method: Method::new(method),
         ..Default::default()
     }
+    .with(
+        &isr::visibility::VISIBILITY,
+        isr::visibility::Visibility::None,
+    )
 }
 
 /// `s` with the parameters that set the cost of its method made small, only

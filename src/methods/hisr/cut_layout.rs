@@ -148,9 +148,12 @@ mod tests {
             method: Method::new("hisr"),
             ..Default::default()
         };
-        if grid {
-            VISIBILITY.set(&mut s, Visibility::Voxels);
-        }
+        let v = if grid {
+            Visibility::Voxels
+        } else {
+            Visibility::None
+        };
+        VISIBILITY.set(&mut s, v);
         s
     }
 
