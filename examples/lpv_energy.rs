@@ -5,7 +5,7 @@
 //! same size until its noise is under 3% (minutes a scene on lavapipe's
 //! CPUs; every point shares it).
 //!
-//!     cargo run --release --example lpv_energy [-- [--scenes a,b] [--scale S] [--out DIR] [POINT...]]
+//!     cargo run --release --example lpv_energy [-- [--scenes a,b] [--scale S] [--out DIR] [--cache DIR] [POINT...]]
 //!
 //! `--scenes` names bench scenes (default: the stress scenes and `bunny`,
 //! whose mesh is read from the archive folder, `../shared/scenes`);
@@ -16,7 +16,9 @@
 //! it is left as it is); `--out`
 //! writes, per scene and point, `DIR/SCENE-K.png`: the truth's indirect
 //! irradiance on the left, point K's on the right, both grey, white at four
-//! times the truth's mean (to see where the light goes). A POINT
+//! times the truth's mean (to see where the light goes); `--cache` is where
+//! each scene's truth is kept for the next run (default
+//! `target/lpv_energy`). A POINT
 //! is LPV's parameters as `name=value` pairs joined by commas
 //! (`lpv-size=16,lpv-iterations=16`); `default` is the method's defaults,
 //! and the only point when none is given.
@@ -29,8 +31,10 @@
 
 use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
-use isr::bench::truth::{trace, ShadowMaps, Truth};
+use isr::bench::truth::{trace, ShadowMaps, Truth, TruthMask};
+use isr::bounces::Bounces;
 use isr::methods::lpv::{self, grid, Layout};
+use isr::readback::Readback;
 use isr::renderer::Renderer;
 use isr::scene::Scene;
 use isr::settings::{Params, RenderSettings};
@@ -69,6 +73,50 @@ fn scaled(mut scene: Scene, s: f32) -> Scene {
         l.range = l.range.map(|r| r * s);
     }
     scene
+}
+
+/// The truth's indirect image, mask, samples and noise, as raw words in
+/// `file` (a truth takes minutes; every run with the same scene and scale
+/// shares it).
+fn save(file: &std::path::Path, t: &Truth) -> Result<()> {
+    std::fs::create_dir_all(file.parent().context("a cache file has a folder")?)?;
+    let mut words: Vec<f32> = vec![t.spp as f32, t.noise as f32];
+    words.extend(t.image.indirect.iter().flatten());
+    words.extend(t.mask.mask.iter().map(|&m| m as u8 as f32));
+    std::fs::write(file, bytemuck::cast_slice(&words))?;
+    Ok(())
+}
+
+/// The truth `save` wrote for a frame like `image`, if there is one of its
+/// size.
+fn load(file: &std::path::Path, image: &Readback) -> Option<Truth> {
+    let bytes = std::fs::read(file).ok()?;
+    let words: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let n = image.indirect.len();
+    if words.len() != 2 + 5 * n {
+        return None;
+    }
+    let mut truth = image.clone();
+    truth.indirect = words[2..2 + 4 * n]
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    let mask: Vec<bool> = words[2 + 4 * n..].iter().map(|&m| m > 0.5).collect();
+    Some(Truth {
+        image: truth,
+        bounces: Bounces::ONE,
+        mask: TruthMask {
+            geometry: image.position.iter().filter(|p| p[3] > 0.0).count(),
+            mask,
+            geometric_edges: 0,
+            shadow_edges: 0,
+        },
+        spp: words[0] as u32,
+        noise: words[1] as f64,
+    })
 }
 
 /// A point's parameters from `name=value,...` (`default`: none).
@@ -156,6 +204,7 @@ fn main() -> Result<()> {
     let mut points = vec![];
     let mut out: Option<PathBuf> = None;
     let mut scale = 1.0f32;
+    let mut cache = PathBuf::from("target/lpv_energy");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if a == "--scenes" {
@@ -163,6 +212,8 @@ fn main() -> Result<()> {
             scenes = value.split(',').map(str::to_string).collect();
         } else if a == "--scale" {
             scale = args.next().context("--scale takes a number")?.parse()?;
+        } else if a == "--cache" {
+            cache = args.next().context("--cache takes a folder")?.into();
         } else if a == "--out" {
             out = Some(args.next().context("--out takes a folder")?.into());
         } else {
@@ -195,12 +246,25 @@ fn main() -> Result<()> {
             let t = match &truth {
                 Some(t) => t,
                 None => {
-                    eprintln!("{name}: tracing the truth");
-                    let shadows =
-                        ShadowMaps::new(r.light_views(), r.render_origin(), SIZE, s.pcf_radius);
-                    truth.insert(trace(&scene, &image, &shadows, NOISE, 1, |spp, noise| {
-                        eprintln!("{name}: {spp} spp, noise {noise:.4}")
-                    }))
+                    let file = cache.join(format!("{name}-{scale}.bin"));
+                    let t = match load(&file, &image) {
+                        Some(t) => t,
+                        None => {
+                            eprintln!("{name}: tracing the truth");
+                            let shadows = ShadowMaps::new(
+                                r.light_views(),
+                                r.render_origin(),
+                                SIZE,
+                                s.pcf_radius,
+                            );
+                            let t = trace(&scene, &image, &shadows, NOISE, 1, Bounces::ONE, {
+                                |spp, noise| eprintln!("{name}: {spp} spp, noise {noise:.4}")
+                            });
+                            save(&file, &t)?;
+                            t
+                        }
+                    };
+                    truth.insert(t)
                 }
             };
             let (ratio, error) = compare(t, &image.position, &image.indirect);

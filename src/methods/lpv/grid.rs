@@ -70,7 +70,8 @@ pub const AHEAD: f32 = 0.375;
 /// (`lpv_top_exponent`).
 pub fn top_exponent(lo: Vec3, hi: Vec3, size: u32) -> i32 {
     let side = (hi - lo).max_element();
-    if !(side > 0.0) {
+    // An empty or degenerate (NaN) scene: cells of 1 m.
+    if side.is_nan() || side <= 0.0 {
         return 0;
     }
     let room = (size - 3) as f32;
