@@ -13,7 +13,7 @@ mod scheme;
 use common::*;
 use glam::{DVec3, IVec3, Vec3};
 use isr::methods::lpv::grid::{self, Cascade, Grid};
-use isr::methods::lpv::{CASCADES, ITERATIONS, OCCLUSION, SIZE};
+use isr::methods::lpv::{Layout, CASCADES, ITERATIONS, OCCLUSION, SIZE};
 use isr::readback::{read_regions, Region};
 use isr::scene::{cornell::cornell_box, Camera, LightKind, Scene};
 use isr::settings::RenderSettings;
@@ -244,29 +244,47 @@ fn wall_scene() -> Scene {
 fn a_wall_in_the_geometry_volume_blocks_the_light_behind_it() {
     let scene = wall_scene();
     let gpu = gpu();
-    let read = |occlusion: bool| {
-        let s = settings_at(64, 128, occlusion);
-        render(&gpu, &scene, &s, 1).readback
+    // 32 steps, once across a cascade (the default's rule): the receiver
+    // lies 14 finest cells from the wall's lit side, beyond 8 steps' reach.
+    let at = |occlusion| settings_at(64, 128, occlusion).with(&ITERATIONS, 32);
+    let s = at(true);
+    let rendered = render(&gpu, &scene, &s, 1);
+    let on = rendered.readback;
+    let off = render(&gpu, &scene, &at(false), 1).readback;
+    // The receiver's pixels that read the finest cascade (1/16 m cells, the
+    // wall 1.6 of them thick) alone: in a coarser one (1/8 m and up) the
+    // wall is thinner than a cell and leaks (8.6).
+    let l = Layout::of(&s);
+    let finest = grid::cascades(&rendered.uniforms, &l)[0];
+    // Positions are read back in world space; the cascades lie relative
+    // to the render origin.
+    let in_finest = |p: &[f32; 4], n: &[f32; 4]| {
+        let (p, n) = (dvec(p) - rendered.origin, dvec(n));
+        let g = finest.grid_position(p + 0.5 * finest.cell as f64 * n) - DVec3::splat(0.5);
+        let inner = g.min(DVec3::splat(l.size as f64 - 1.0) - g).min_element();
+        inner >= l.blend_cells() as f64
     };
-    let (on, off) = (read(true), read(false));
     if let Ok(dir) = std::env::var("LPV_DUMP") {
         for (name, r) in [("on", &on), ("off", &off)] {
             let img = image::RgbaImage::from_raw(r.width, r.height, r.display.clone()).unwrap();
             img.save(format!("{dir}/wall-{name}.png")).unwrap();
         }
     }
+    let receiver = |p: &[f32; 4], n: &[f32; 4]| p[3] > 0.0 && p[0] > 0.75 && in_finest(p, n);
     let behind = |r: &isr::readback::Readback| -> f64 {
         r.position
             .iter()
+            .zip(&r.normal)
             .zip(&r.indirect)
-            .filter(|(p, _)| p[3] > 0.0 && p[0] > 0.75)
+            .filter(|((p, n), _)| receiver(p, n))
             .map(|(_, e)| e[0] as f64)
             .sum()
     };
     let pixels = on
         .position
         .iter()
-        .filter(|p| p[3] > 0.0 && p[0] > 0.75)
+        .zip(&on.normal)
+        .filter(|(p, n)| receiver(p, n))
         .count();
     let (a, b) = (behind(&on), behind(&off));
     println!(
@@ -278,7 +296,7 @@ fn a_wall_in_the_geometry_volume_blocks_the_light_behind_it() {
     // The wall's surfels cover its geometry cells (A / h^2 >= 1): light
     // crossing it through a front face (along the normal) is blocked
     // entirely, through a side face (26.6 degrees off) to 1 - 0.93: at most
-    // 7% passes. Measured: 6.3%.
+    // 7% passes. Measured: 5.1%.
     assert!(a < 0.1 * b, "the wall leaves {:.3} of the light", a / b);
 }
 
@@ -332,14 +350,17 @@ fn occluded_propagation_is_the_scheme_and_the_geometry_volume_holds_the_surfels(
 
 #[test]
 fn cascades_nest() {
-    // A floor 14 m wide under a sun from straight above, seen from 3 m up
+    // A floor 16 m wide under a sun from straight above, seen from 3 m up
     // (32 cells: the coarsest cell is the first power of two with 29 cells
-    // over 14 m, 1/2 m; the others 1/8 and 1/4 m): a laterally uniform
+    // over 16 m, 1 m; the others 1/4 and 1/2 m): a laterally uniform
     // emitter of exitance rho E = 1 W/m^2, which gives a downward-facing
-    // point above it 1 W/m^2 at any height. 8 steps: the floor's edge lies
-    // 14 cells from the centre of the coarsest cascade, beyond the light's
-    // reach, so each cascade sees the emitter as unbounded (the values
-    // below were measured at 8 steps).
+    // point above it 1 W/m^2 at any height. The RSM's 128 texels over the
+    // 16 m give every finest cell the same four VPLs (a 14 m floor, 1.3
+    // texels a cell, injects unevenly and the cascades part by 14%). 8
+    // steps: the floor's edge lies 8 cells from the centre of the coarsest
+    // cascade, where the scheme carries almost nothing (8.4), so each
+    // cascade sees the emitter as unbounded (the values below were measured
+    // at 8 steps).
     let camera = Camera::look_at(
         Vec3::new(0.0, 3.0, 0.0),
         Vec3::ZERO,
@@ -347,7 +368,7 @@ fn cascades_nest() {
         60f32.to_radians(),
         0.05,
     );
-    let scene = floor_scene(sun(-Vec3::Y, 2.0), camera, 7.0, 0.5);
+    let scene = floor_scene(sun(-Vec3::Y, 2.0), camera, 8.0, 0.5);
     let gpu = gpu();
     let mut probe = Probe::new(&gpu, &scene, &settings_at(64, 128, true));
     probe.render();
@@ -355,7 +376,7 @@ fn cascades_nest() {
     let cascades = grid::cascades(&probe.renderer.frame_uniforms(), &l);
     assert_eq!(
         cascades.iter().map(|c| c.cell).collect::<Vec<_>>(),
-        [0.125, 0.25, 0.5]
+        [0.25, 0.5, 1.0]
     );
     let sum = probe.sum();
     let origin = probe.renderer.render_origin();
@@ -519,7 +540,12 @@ fn the_near_floor_of_the_cornell_box_is_lit_at_the_defaults() {
             if near { "near" } else { "far" },
             a / b
         );
-        assert!(count > 100, "the camera sees the floor");
+        // The box's blocks hide most of the far half at 64 x 64: a mean over
+        // 10 pixels is still a mean of the light across them.
+        assert!(
+            count > if near { 100 } else { 10 },
+            "the camera sees the floor"
+        );
         a / b
     };
     for near in [true, false] {
