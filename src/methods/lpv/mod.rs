@@ -227,7 +227,8 @@ mod tests {
             (DEFAULT_SIZE, DEFAULT_CASCADES, DEFAULT_SIZE, true)
         );
         // The steps follow the cells unless set.
-        let l = Layout::of(&s.clone().with(&SIZE, 32).with(&CASCADES, 3));
+        let s32 = s.clone().with(&SIZE, 32).with(&CASCADES, 3);
+        let l = Layout::of(&s32);
         assert_eq!((l.size, l.iterations), (32, 32));
         assert_eq!(Layout::of(&s.clone().with(&ITERATIONS, 8)).iterations, 8);
         // 128 VPLs a side: level 2 of 512; 128 / 128 = 1 pixel per surfel.
@@ -236,11 +237,16 @@ mod tests {
             (2, 128, 1)
         );
         assert_eq!(l.bytes(), 32 * 32 * 32 * 3 * (48 + 144 + 64));
-        let small = Layout::of(&RenderSettings {
-            rsm_resolution: 64,
-            ..s.clone()
-        });
-        assert_eq!(small.vpl_level, 0);
+        // 32 cells: an RSM of 64 is injected whole (4 x 32 >= 64); 8 cells
+        // at their 32 texels a side take level 1.
+        let small = |s: &RenderSettings| {
+            Layout::of(&RenderSettings {
+                rsm_resolution: 64,
+                ..s.clone()
+            })
+            .vpl_level
+        };
+        assert_eq!((small(&s32), small(&s)), (0, 1));
         assert!(LpvMethod.check(&s).is_ok());
         assert!(LpvMethod
             .check(&s.clone().with(&ITERATIONS, 64).with(&SIZE, 8))
