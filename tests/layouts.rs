@@ -95,7 +95,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", grid_cube: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", pad5: 4, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -118,6 +118,10 @@ fn frame_uniforms_match_shared_glsl() {
             pad3 => "pad3",
             cube_view_proj => "cube_view_proj",
             grid_cube => "grid_cube",
+            scene_min => "scene_min",
+            pad4 => "pad4",
+            scene_max => "scene_max",
+            pad5 => "pad5",
         ]);
     }
 }
