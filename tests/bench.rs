@@ -437,10 +437,11 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
 /// .csv) and its key keeps it apart, and the report names them. `hisr` and
 /// the dense reference render every bounce too (docs/algorithm.md section
 /// 5.9), so the run warns of no method. The box's first bounce is about
-/// half its indirect light (section 5.4, "Bounces"): with one bounce the
-/// reference was 2.6x as far from the truth of every bounce as from the
-/// truth of one (0.375 and 0.144); rendering every bounce it stays under
-/// twice as far.
+/// half its indirect light (section 5.4, "Bounces"): rendering one bounce
+/// the reference was 2.6x as far from the truth of every bounce as from the
+/// truth of one (0.375 and 0.144); rendering every bounce, 1.98x (0.285).
+/// 2.3x lies between the two: a reference that stopped rendering the later
+/// bounces would fail.
 #[test]
 fn bounces_trace_the_truth_with_as_many_and_every_row_says_which() {
     let dir = temp_dir("bench-bounces");
@@ -493,7 +494,7 @@ fn bounces_trace_the_truth_with_as_many_and_every_row_says_which() {
         "the dense reference against the truth: {e1:.4} (1 bounce), {e_every:.4} (every bounce)"
     );
     assert!(
-        e_every < 2.0 * e1,
+        e_every < 2.3 * e1,
         "{e1} against one bounce, {e_every} against every"
     );
     // Run again with every bounce: its rows and its truth are found.
