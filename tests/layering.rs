@@ -18,6 +18,7 @@ const LAYERS: &[&[&str]] = &[
     &["visibility"],
     &["multires"],
     &["regular_vpls"],
+    &["bounce"],
     &["methods", "readback"],
     &["method_args", "debug_view", "output"],
     &["renderer", "pathtrace"],

@@ -17,6 +17,7 @@ pub mod framing;
 pub mod gltf;
 pub mod grid;
 pub mod measure;
+pub mod sphere;
 
 // Every test binary compiles this kit; most use no grid helper.
 #[allow(unused_imports)]
