@@ -10,46 +10,7 @@ use common::*;
 use glam::Vec3;
 use isr::bench::truth::{truth_mask, ShadowMaps, TruthMask};
 use isr::readback::Readback;
-use isr::scene::{cuboid, Camera, Light, Scene};
-
-fn court(light: Light) -> Scene {
-    let camera = Camera::look_at(
-        Vec3::new(2.6, 2.2, 2.8),
-        Vec3::new(-0.6, 0.2, -0.6),
-        Vec3::Y,
-        50f32.to_radians(),
-        0.05,
-    );
-    let mut s = Scene::empty("court", light, camera);
-    let grey = s.add_material("grey", Vec3::splat(0.6));
-    // Thin walls, seen and lit from both sides.
-    s.materials[grey].double_sided = true;
-    s.add_quad("floor", square(Vec3::ZERO, 2.0), grey);
-    let (h, w) = (0.8, 2.0);
-    s.add_quad(
-        "wall-x",
-        [
-            Vec3::new(-w, 0.0, w),
-            Vec3::new(-w, 0.0, -w),
-            Vec3::new(-w, h, -w),
-            Vec3::new(-w, h, w),
-        ],
-        grey,
-    );
-    s.add_quad(
-        "wall-z",
-        [
-            Vec3::new(-w, 0.0, -w),
-            Vec3::new(w, 0.0, -w),
-            Vec3::new(w, h, -w),
-            Vec3::new(-w, h, -w),
-        ],
-        grey,
-    );
-    let (v, i) = cuboid(Vec3::new(0.3, 0.35, -0.2), Vec3::splat(0.7), 0.4);
-    s.add_mesh("block", v, i, grey);
-    s
-}
+use isr::scene::{Camera, Scene};
 
 /// `scene`'s direct light rasterised at `n` x `n` (RSM 512) and path traced
 /// (one sample: direct light is exact and noise-free), and the truth mask
@@ -86,13 +47,8 @@ fn rendered_and_traced(
 fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
     let gpu = gpu();
     let n = 160;
-    let lights = [
-        (
-            "a low sun behind the walls",
-            sun(Vec3::new(1.0, -0.5, 0.6), 3.0),
-        ),
-        ("a low sun in front", sun(Vec3::new(-1.0, -0.45, 0.35), 3.0)),
-        ("a sun grazing a wall", sun(Vec3::new(0.6, -0.3, -1.0), 3.0)),
+    let mut lights = court::low_suns().to_vec();
+    lights.extend([
         (
             "a spot",
             spot(
@@ -104,9 +60,9 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
             ),
         ),
         ("a point light", point(Vec3::new(1.3, 0.9, 0.7), 8.0)),
-    ];
+    ]);
     for (name, light) in lights {
-        let scene = court(light);
+        let scene = court::court(light);
         let (rendered, traced, compared) = rendered_and_traced(&gpu, &scene, n);
         let raster = &rendered.readback;
         let mask = &compared.mask;
