@@ -51,6 +51,7 @@ fn main() -> anyhow::Result<()> {
             spp: 256,
             seed: 1,
             exposure: 1.0,
+            bounces: isr::bounces::Bounces::ONE,
         },
         |_, _| {},
     );

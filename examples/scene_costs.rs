@@ -127,6 +127,7 @@ fn main() -> anyhow::Result<()> {
                 spp,
                 seed: 1,
                 exposure: 1.0,
+                bounces: isr::bounces::Bounces::ONE,
             },
             |_, _| {},
         );

@@ -32,6 +32,7 @@
 use anyhow::{bail, Result};
 use glam::DVec3;
 use isr::bench::truth::{trace, ShadowMaps, Truth};
+use isr::bounces::Bounces;
 use isr::exact_visibility::gather;
 use isr::methods::hisr::{SHARED_REFINE, SHARED_VISIBILITY, TAU};
 use isr::pathtrace::Occluders;
@@ -223,7 +224,15 @@ fn per_receiver(mut s: RenderSettings) -> RenderSettings {
 fn truth_of(gpu: &Gpu, scene: &Scene, s: &RenderSettings) -> Result<(Truth, Vec<[f32; 4]>)> {
     let f = render(gpu, scene, s)?;
     let shadows = ShadowMaps::new(&f.light_views, f.origin, s.rsm_resolution, s.pcf_radius);
-    let t = trace(scene, &f.readback, &shadows, NOISE, 1, |_, _| {});
+    let t = trace(
+        scene,
+        &f.readback,
+        &shadows,
+        NOISE,
+        1,
+        Bounces::ONE,
+        |_, _| {},
+    );
     Ok((t, f.readback.indirect))
 }
 
@@ -231,7 +240,15 @@ fn voxels_row(gpu: &Gpu, name: &str, scene: &Scene, table: &mut Table) -> Result
     let s = sized("reference", 64);
     let f = render(gpu, scene, &s)?;
     let shadows = ShadowMaps::new(&f.light_views, f.origin, 64, s.pcf_radius);
-    let t = trace(scene, &f.readback, &shadows, NOISE, 1, |_, _| {});
+    let t = trace(
+        scene,
+        &f.readback,
+        &shadows,
+        NOISE,
+        1,
+        Bounces::ONE,
+        |_, _| {},
+    );
     let vpls = isr::exact_visibility::texel_vpls(&f.readback.rsm);
     let exact = gather(&f.readback, &vpls, Some(&Occluders::new(scene)), |_, _| {});
     let hisr = sized("hisr", 64);

@@ -9,6 +9,7 @@
 //! barriers, pipelines, timing), `scene`. docs/architecture.md has the map.
 
 pub mod bench;
+pub mod bounces;
 pub mod cli;
 pub mod debug_view;
 pub mod exact_visibility;

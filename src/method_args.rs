@@ -23,11 +23,15 @@ fn help_text(p: &dyn AnyParam) -> String {
         r if r == crate::settings::Range::ANY => String::new(),
         r => format!("; {}", r.describe()),
     };
+    // A run parameter no method reads yet says who does in its help.
+    let readers = match readers.is_empty() {
+        true => String::new(),
+        false => format!(" [methods: {}]", readers.join(", ")),
+    };
     format!(
-        "{}. [default: {}{range}] [methods: {}]",
+        "{}. [default: {}{range}]{readers}",
         p.help(),
-        p.default_text(),
-        readers.join(", ")
+        p.default_text()
     )
 }
 

@@ -21,6 +21,11 @@ pub struct Readback {
     pub final_radiance: Vec<[f32; 4]>,
     pub direct: Vec<[f32; 4]>,
     pub indirect: Vec<[f32; 4]>,
+    /// The indirect image's light by bounce where the renderer keeps it
+    /// apart: the path tracer's layers (`bounces::LAYERS`: bounces 1, 2, 3,
+    /// then 4 on), as many as its run traced, summing to `indirect`. Empty
+    /// from the GPU, which renders one bounce.
+    pub bounces: Vec<Vec<[f32; 4]>>,
     pub albedo: Vec<[f32; 4]>,
     pub normal: Vec<[f32; 4]>,
     /// xyz world position, w view depth (0 for background).
@@ -273,6 +278,7 @@ pub fn read_frame(gpu: &Gpu, t: &Targets) -> Result<Readback> {
         final_radiance: r.rgba("final")?,
         direct: r.rgba("direct")?,
         indirect: r.rgba("indirect")?,
+        bounces: vec![],
         albedo: r.rgba("albedo")?,
         normal: r.rgba("normal")?,
         position: r.rgba("position")?,

@@ -1,33 +1,31 @@
-//! Property test of the scene loaders on stable Rust (issues 14 and 27):
+//! Property test of the glTF loader on stable Rust (issues 14 and 27):
 //! thousands of files generated and mutated from a seed corpus (the Cornell
 //! box as glTF and as GLB, small GLBs with sparse accessors, textures and
-//! node DAGs; small OBJ files naming MTL libraries and textures, mutated
-//! line by line and byte by byte), with a fixed seed. Every input must give a scene whose data is sane or an
-//! error, never a panic, a slow load (a hang) or a large allocation; the
-//! loader is called without its panic guard (`load_bytes`).
+//! node DAGs), with a fixed seed. Every input must give a scene whose data
+//! is sane or an error, never a panic, a slow load (a hang) or a large
+//! allocation, under `Limits::FUZZ`; the loader is called without its panic
+//! guard (`load_bytes`). The OBJ and description loaders have their own,
+//! tests/fuzz_loader_obj.rs.
 //!
 //! Inputs that fail are written to `tests/fuzz-regressions/` (commit them);
 //! every file there is replayed first. `ISR_FUZZ_CASES=N` runs N mutated
-//! cases instead of the default (`ISR_FUZZ_OBJ_CASES=N` for the OBJ
-//! loader); `ISR_FUZZ_SEED=S` changes the seed;
+//! cases instead of the default; `ISR_FUZZ_SEED=S` changes the seed;
 //! `ISR_FUZZ_TRACE=1` writes each input to `target/fuzz-last.*` before it is
 //! loaded (to find the input that aborted the process, should one).
 mod common;
+#[path = "fuzz_loader/harness.rs"]
+mod harness;
 #[path = "fuzz_loader/mutate.rs"]
 mod mutate;
 
 use common::gltf::*;
-use common::measure::{peak_allocated, Counting};
+use common::measure::Counting;
 use common::temp_dir;
 use isr::scene::gltf_load::{load_bytes, LoadOptions};
 use isr::scene::limits::Limits;
-use isr::scene::obj_load;
 use mutate::{mutate_bytes, mutate_json, Rng};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
 
 /// Counts each thread's live bytes and their peak, to catch allocations no
 /// budget bounds.
@@ -35,29 +33,7 @@ use std::time::{Duration, Instant};
 static ALLOC: Counting = Counting;
 
 /// Tight budgets so that what they allow is small and anything else stands out.
-const FUZZ_LIMITS: Limits = Limits {
-    scene_file_bytes: 8 << 20,
-    line_bytes: 1 << 20,
-    material_library_bytes: 1 << 20,
-    description_bytes: 1 << 16,
-    buffer_bytes: 8 << 20,
-    image_file_bytes: 1 << 20,
-    texture_dimension: 1024,
-    texture_pixels: 1 << 18,
-    node_visits: 1 << 12,
-    hierarchy_depth: 64,
-    triangles: 1 << 15,
-    vertices: 1 << 15,
-    coordinate: 1e6,
-    min_extent: 1e-6,
-};
-/// More than the budgets above can account for (a few copies of 8 MiB of
-/// buffers, 32k vertices, 256k texels).
-const MAX_PEAK: usize = 96 << 20;
-/// One load taking this long is a hang (they take well under 10 ms): a
-/// guard, 300 times a load's time, like the watchdog's 30 s abort.
-const SLOW: Duration = Duration::from_secs(3);
-
+const FUZZ_LIMITS: Limits = Limits::FUZZ;
 /// One fuzz input: bytes and the file name they are loaded as.
 #[derive(Clone)]
 struct Case {
@@ -79,10 +55,6 @@ fn fixture_dir() -> PathBuf {
     std::fs::write(d.join("t.png"), small_png()).unwrap();
     std::fs::write(d.join("big.png"), png_header_only(4096, 4096)).unwrap();
     std::fs::create_dir_all(d.join("dir")).unwrap();
-    // Libraries the OBJ seeds (and their mutations) name.
-    for (name, mtl) in OBJ_LIBRARIES {
-        std::fs::write(d.join(name), mtl).unwrap();
-    }
     #[cfg(unix)]
     {
         let _ = std::process::Command::new("mkfifo")
@@ -133,134 +105,6 @@ fn corpus() -> Vec<(Value, Option<Vec<u8>>)> {
     out
 }
 
-/// MTL libraries in the fixture folder: good, naming a missing texture, a
-/// FIFO, a directory, a link out, a too-large header, naming itself, broken.
-const OBJ_LIBRARIES: &[(&str, &str)] = &[
-    (
-        "m.mtl",
-        "newmtl a\nKd 0.5 0.6 0.7\nmap_Kd t.png\nnewmtl b\nKd 1 0 0\nNs 10\n",
-    ),
-    ("gone.mtl", "newmtl a\nmap_Kd gone.png\n"),
-    ("pipe.mtl", "newmtl a\nmap_Kd pipe\n"),
-    ("dir.mtl", "newmtl a\nmap_Kd dir\n"),
-    ("link.mtl", "newmtl a\nmap_Kd link\n"),
-    ("big.mtl", "newmtl a\nmap_Kd big.png\n"),
-    ("self.mtl", "mtllib self.mtl\nnewmtl a\nKd 0.2 0.2 0.2\n"),
-    (
-        "broken.mtl",
-        "newmtl a\nKd 0.5\nKd 1 2\nmap_Kd -s 1 1\n\u{0}\n",
-    ),
-];
-
-/// OBJ seeds: a textured quad, polygons and relative indices, normals,
-/// several objects and materials.
-fn obj_corpus() -> Vec<String> {
-    vec![
-        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3 4/4\n".into(),
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf -5 -4 -3 -2 -1\no second\nv 0 0 1\nv 1 0 1\nv 1 1 1\nf 6 7 8\n".into(),
-        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvn 1 0 0\nusemtl b\nf 1//1 2//1 3//1\nusemtl a\nf 1//2 3//2 4//2\ng other\nusemtl missing\nf 2 3 4\n".into(),
-        "# crlf\r\nmtllib self.mtl\r\nv 0 0 0 1\r\nv 1 0 0 0.5\r\nv 0 1 0 1 0 0\r\ns 1\r\nl 1 2\r\nf 1 2 3\r\n".into(),
-    ]
-}
-
-/// A line-level change to an OBJ: a line dropped, repeated or cut, a
-/// number or index replaced by a hostile one, a statement inserted.
-fn mutate_obj(text: &mut String, rng: &mut Rng) {
-    let mut lines: Vec<String> = text.split('\n').map(str::to_string).collect();
-    let n = lines.len().max(1);
-    let k = rng.below(n);
-    const NUMBERS: &[&str] = &[
-        "0",
-        "-1",
-        "-9",
-        "9",
-        "1e39",
-        "-1e39",
-        "nan",
-        "inf",
-        "1e30",
-        "1e-30",
-        "4294967296",
-        "-2147483649",
-        "99999999999999999999",
-        "0x10",
-        "",
-        "1/",
-        "/1",
-        "1//",
-        "1/2/3/4",
-        "+3",
-    ];
-    const LINES: &[&str] = &[
-        "mtllib m.mtl",
-        "mtllib gone.mtl",
-        "mtllib pipe.mtl",
-        "mtllib dir.mtl",
-        "mtllib link.mtl",
-        "mtllib big.mtl",
-        "mtllib self.mtl",
-        "mtllib broken.mtl",
-        "mtllib ../m.mtl",
-        "mtllib /etc/passwd",
-        "mtllib fuzz.obj",
-        "mtllib dir",
-        "mtllib pipe",
-        "mtllib",
-        "usemtl a",
-        "usemtl",
-        "usemtl b",
-        "o",
-        "g a b",
-        "s off",
-        "vt 0.5",
-        "vn 0 0 0",
-        "v 1 2 3 4 5",
-        "f 1 1 1",
-        "f 1 2",
-        "f",
-        "l 1 2 3",
-        "p 1",
-        "curv 0 1 1 2",
-        "vp 0.5",
-        "\u{0}",
-        "\r",
-        "f 1/1/1 2/2/2 3/3/3",
-    ];
-    match rng.below(7) {
-        0 if lines.len() > 1 => {
-            lines.remove(k);
-        }
-        1 => {
-            let l = lines[k].clone();
-            lines.insert(k, l);
-        }
-        2 => {
-            let l = &mut lines[k];
-            let cut = rng.below(l.len() + 1);
-            if l.is_char_boundary(cut) {
-                l.truncate(cut);
-            }
-        }
-        3 | 4 => {
-            let words: Vec<String> = lines[k].split(' ').map(str::to_string).collect();
-            if words.len() > 1 {
-                let mut words = words;
-                let w = 1 + rng.below(words.len() - 1);
-                words[w] = rng.pick(NUMBERS).to_string();
-                lines[k] = words.join(" ");
-            }
-        }
-        5 => lines.insert(k, rng.pick(LINES).to_string()),
-        _ => {
-            // A long face, fanned.
-            let m = 3 + rng.below(200);
-            let face: Vec<String> = (0..m).map(|i| format!("{}", 1 + i % 4)).collect();
-            lines.insert(k, format!("f {}", face.join(" ")));
-        }
-    }
-    *text = lines.join("\n");
-}
-
 fn to_case(doc: &Value, bin: Option<&[u8]>) -> Case {
     match bin {
         Some(b) => Case {
@@ -274,58 +118,28 @@ fn to_case(doc: &Value, bin: Option<&[u8]>) -> Case {
     }
 }
 
-static PANIC_MESSAGE: Mutex<String> = Mutex::new(String::new());
-
-/// What went wrong with one input, if anything; else the loader's error
-/// (None: it gave a scene).
+/// Loads one glTF input and checks what it gives: `Ok(None)` for a sane
+/// scene, `Ok(Some(error))`, `Err(problem)` (`harness::run`).
 fn check(dir: &Path, case: &Case) -> Result<Option<String>, String> {
     let options = LoadOptions {
         allow_outside_uris: false,
         limits: FUZZ_LIMITS,
     };
-    let path = dir.join(case.name);
-    let started = Instant::now();
-    let (result, peak) = peak_allocated(|| {
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            let loaded = if case.name.ends_with(".obj") {
-                obj_load::load_bytes(&path, &case.bytes, &options)
-            } else {
-                load_bytes(&path, &case.bytes, &options)
-            };
-            loaded.map(|s| {
-                // What the renderer does first with a scene.
-                let bounds = s.bounds();
-                let state = s.rest_state();
-                (s, bounds, state)
-            })
-        }))
-    });
-    let took = started.elapsed();
-    let problem = match &result {
-        Err(_) => Some(format!(
-            "panic: {}",
-            PANIC_MESSAGE.lock().map(|m| m.clone()).unwrap_or_default()
-        )),
-        Ok(Err(e)) => {
+    match load_bytes(&dir.join(case.name), &case.bytes, &options) {
+        Err(e) => {
             let msg = format!("{e:#}");
-            (msg.is_empty() || msg.contains("root:x:"))
-                .then(|| format!("unclear or leaking error: {msg}"))
+            if msg.is_empty() || msg.contains("root:x:") {
+                return Err(format!("unclear or leaking error: {msg}"));
+            }
+            Ok(Some(msg))
         }
-        Ok(Ok((s, bounds, state))) => sane(s, *bounds, state),
-    };
-    if let Some(p) = problem {
-        return Err(p);
+        Ok(s) => {
+            // What the renderer does first with a scene.
+            let bounds = s.bounds();
+            let state = s.rest_state();
+            sane(&s, bounds, &state).map_or(Ok(None), Err)
+        }
     }
-    if took > SLOW {
-        return Err(format!("took {took:?}"));
-    }
-    if peak > MAX_PEAK {
-        return Err(format!("allocated {} MiB at peak", peak >> 20));
-    }
-    Ok(match result {
-        Ok(Err(e)) => Some(format!("{e:#}")),
-        _ => None,
-    })
 }
 
 /// A loaded scene holds only what the renderer can take.
@@ -387,113 +201,35 @@ fn sane(
     None
 }
 
-fn regressions_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-regressions")
-}
-
-/// Keeps a failing input as a regression test.
-fn save(case: &Case, problem: &str) -> PathBuf {
-    let hash = case.bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
-    });
-    let ext = Path::new(case.name).extension().unwrap().to_str().unwrap();
-    let dir = regressions_dir();
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(format!("{hash:016x}.{ext}"));
-    std::fs::write(&p, &case.bytes).unwrap();
-    std::fs::write(p.with_extension(format!("{ext}.txt")), problem).unwrap();
-    p
-}
-
-/// Aborts the process, keeping the input, when one load hangs: a hang
-/// inside the loader cannot be interrupted from the test's own thread.
-fn watchdog(current: &'static Mutex<Option<Case>>, started_ms: &'static AtomicU64) {
-    static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
-    let epoch = *EPOCH.get_or_init(Instant::now);
-    std::thread::spawn(move || loop {
-        std::thread::sleep(Duration::from_millis(200));
-        let since = started_ms.load(Relaxed);
-        if since == u64::MAX {
-            continue;
-        }
-        let now = epoch.elapsed().as_millis() as u64;
-        if now.saturating_sub(since) > 30_000 {
-            if let Some(case) = current.lock().ok().and_then(|c| c.clone()) {
-                let p = save(&case, "hang: a load ran for more than 30 s");
-                eprintln!("fuzz_loader: a load hangs; input kept as {}", p.display());
-            }
-            std::process::abort();
-        }
-    });
-}
-
 #[test]
 fn loader_never_panics_hangs_or_allocates_without_bound() {
-    static CURRENT: Mutex<Option<Case>> = Mutex::new(None);
-    static STARTED_MS: AtomicU64 = AtomicU64::new(u64::MAX);
-    static HOOKED: AtomicBool = AtomicBool::new(false);
-    if !HOOKED.swap(true, Relaxed) {
-        // Panics inside a load are recorded with their input; the test's own
-        // assertions print as usual.
-        let default = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if STARTED_MS.load(Relaxed) == u64::MAX {
-                return default(info);
-            }
-            if let Ok(mut m) = PANIC_MESSAGE.lock() {
-                *m = info.to_string();
-            }
-        }));
-    }
-    let epoch = Instant::now();
-    watchdog(&CURRENT, &STARTED_MS);
+    let epoch = harness::start();
     let dir = fixture_dir();
     let trace = std::env::var_os("ISR_FUZZ_TRACE").is_some();
     let trace_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target");
     let mut failures = Vec::new();
     // Some(the loader's error or None for a scene), None: the input failed.
     let run = |case: Case, keep: bool, failures: &mut Vec<String>| -> Option<Option<String>> {
+        let ext = Path::new(case.name).extension().unwrap().to_str().unwrap();
         if trace {
-            let ext = Path::new(case.name).extension().unwrap().to_str().unwrap();
             let _ = std::fs::write(trace_dir.join(format!("fuzz-last.{ext}")), &case.bytes);
         }
-        *CURRENT.lock().unwrap() = Some(case.clone());
-        STARTED_MS.store(epoch.elapsed().as_millis() as u64, Relaxed);
-        let problem = check(&dir, &case);
-        STARTED_MS.store(u64::MAX, Relaxed);
-        match problem {
-            Ok(error) => Some(error),
-            Err(p) => {
-                let kept = if keep {
-                    format!(" (kept as {})", save(&case, &p).display())
-                } else {
-                    String::new()
-                };
-                failures.push(format!("{}{kept}: {p}", case.name));
-                None
-            }
-        }
+        harness::run(ext, &case.bytes, keep, failures, || check(&dir, &case))
     };
 
     // Every input that ever failed, first.
     let mut replayed = 0;
-    if let Ok(entries) = std::fs::read_dir(regressions_dir()) {
-        let mut files: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-        files.sort();
-        for p in files {
-            let name = match p.extension().and_then(|e| e.to_str()) {
-                Some("gltf") => "fuzz.gltf",
-                Some("glb") => "fuzz.glb",
-                Some("obj") => "fuzz.obj",
-                _ => continue,
-            };
-            let bytes = std::fs::read(&p).unwrap();
-            if run(Case { name, bytes }, false, &mut failures).is_none() {
-                let last = failures.pop().unwrap();
-                failures.push(format!("regression {}: {last}", p.display()));
-            }
-            replayed += 1;
+    for (ext, bytes, p) in harness::regressions(&["gltf", "glb"]) {
+        let name = if ext == "glb" {
+            "fuzz.glb"
+        } else {
+            "fuzz.gltf"
+        };
+        if run(Case { name, bytes }, false, &mut failures).is_none() {
+            let last = failures.pop().unwrap();
+            failures.push(format!("regression {}: {last}", p.display()));
         }
+        replayed += 1;
     }
 
     let seed: u64 = std::env::var("ISR_FUZZ_SEED")
@@ -556,61 +292,13 @@ fn loader_never_panics_hangs_or_allocates_without_bound() {
         }
         match run(case, true, &mut failures) {
             Some(None) => scenes += 1,
-            Some(Some(e)) => {
-                // The message without the file's path, cut before details.
-                let e = e.split(": ").skip(1).take(2).collect::<Vec<_>>().join(": ");
-                let key: String = e.chars().take(60).collect();
-                *messages.entry(key).or_insert(0usize) += 1;
-            }
+            Some(Some(e)) => *messages.entry(harness::message_key(&e)).or_insert(0usize) += 1,
             None => {}
         }
         if failures.len() > 20 {
             break;
         }
     }
-    // The OBJ loader: its seeds load, then mutated cases.
-    let obj_seeds = obj_corpus();
-    for seed in &obj_seeds {
-        let options = LoadOptions {
-            limits: FUZZ_LIMITS,
-            ..Default::default()
-        };
-        if let Err(e) = obj_load::load_bytes(&dir.join("fuzz.obj"), seed.as_bytes(), &options) {
-            panic!("an OBJ seed does not load: {e:#}\n{seed}");
-        }
-    }
-    let obj_cases: usize = std::env::var("ISR_FUZZ_OBJ_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(10_000);
-    let mut obj_scenes = 0usize;
-    for i in 0..obj_cases {
-        let mut text = rng.pick(&obj_seeds).clone();
-        for _ in 0..1 + rng.below(4) {
-            mutate_obj(&mut text, &mut rng);
-        }
-        let mut bytes = text.into_bytes();
-        if i % 4 == 0 {
-            mutate_bytes(&mut bytes, &mut rng);
-        }
-        let case = Case {
-            name: "fuzz.obj",
-            bytes,
-        };
-        match run(case, true, &mut failures) {
-            Some(None) => obj_scenes += 1,
-            Some(Some(e)) => {
-                let e = e.split(": ").skip(1).take(2).collect::<Vec<_>>().join(": ");
-                let key: String = e.chars().take(60).collect();
-                *messages.entry(format!("obj: {key}")).or_insert(0usize) += 1;
-            }
-            None => {}
-        }
-        if failures.len() > 20 {
-            break;
-        }
-    }
-    println!("fuzz_loader: {obj_cases} mutated OBJ cases, {obj_scenes} of them scenes");
     let mut common: Vec<_> = messages.into_iter().collect();
     common.sort_by_key(|c| std::cmp::Reverse(c.1));
     for (m, n) in common.iter().take(15) {

@@ -58,6 +58,21 @@ fn non_finite_positions_and_normals_are_refused() {
     );
 }
 
+/// Texture coordinates are held to `Limits::texcoord`, as an OBJ's are:
+/// (3e38, -3e38) is finite, and made every pixel NaN.
+#[test]
+fn texture_coordinates_past_their_limit_are_refused() {
+    let dir = temp_dir("scene-uv");
+    let mut tri = Doc::triangle();
+    let uv = tri.floats(&[0., 0., 3e38, -3e38, 0., 1.], "VEC2");
+    tri.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    let e = fails_on(&dir, &tri.embedded());
+    assert!(
+        e.contains("vertex 1 has the TEXCOORD_0 [3e38, -3e38]") && e.contains("up to 65536"),
+        "{e}"
+    );
+}
+
 #[test]
 fn attributes_of_the_wrong_type_are_refused() {
     let dir = temp_dir("scene-types");
@@ -197,6 +212,13 @@ fn degenerate_cameras_are_refused() {
         ("znear", 1e-45, "znear"),
         ("yfov", 3.5, "yfov"),
         ("yfov", 1e-40, "yfov"),
+        // Finite scale, but narrower than f32 tells a pixel's rays apart:
+        // accepted before (a black image).
+        (
+            "yfov",
+            1e-20,
+            "yfov 1e-20 radians: the vertical field of view must be between",
+        ),
         // A znear that is a normal float but underflows against the scene.
         ("znear", 1e-35, "depths would underflow"),
     ] {

@@ -11,7 +11,7 @@ use std::path::Path;
 /// below its own, none of its own layer or above.
 const LAYERS: &[&[&str]] = &[
     &["settings", "gpu_types", "progress", "scene"],
-    &["view", "vk"],
+    &["view", "vk", "bounces"],
     &["frame"],
     &["passes"],
     &["voxel_grid"],

@@ -17,6 +17,7 @@ fn pt(scene: &Scene, width: u32, height: u32, spp: u32, seed: u64) -> isr::readb
             spp,
             seed,
             exposure: 1.0,
+            bounces: isr::bounces::Bounces::ONE,
         },
         |_, _| {},
     )

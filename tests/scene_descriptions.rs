@@ -196,7 +196,7 @@ fn bad_descriptions_say_where_and_what() {
         ("{\"mesh\": \"quad.obj\",\n \"lihgts\": []}".to_string(), "line 2 column 9: unknown field `lihgts`, expected one of `mesh`"),
         (r#"{"mesh": 3}"#.into(), "\"mesh\" must be a file name"),
         (r#"{"mesh": "quad.obj", "scale": 0}"#.into(), "scale 0"),
-        (r#"{"mesh": "quad.obj", "up": "sideways"}"#.into(), "up \"sideways\""),
+        (r#"{"mesh": "quad.obj", "up": "sideways"}"#.into(), "up 'sideways'"),
         (r#"{"mesh": "quad.obj", "albedo": [2, 0, 0]}"#.into(), "from 0 to 1"),
         (spot(r#", "cone": 95"#), "light 0: cone 95"),
         (spot(r#", "intensity": -1"#), "light 0: intensity -1"),
@@ -314,4 +314,121 @@ fn a_missing_archive_folder_says_how_to_get_it() {
         e.contains("bench scene sponza") && e.contains("ISR_SCENES"),
         "{e}"
     );
+}
+
+/// Orbit centres and fields of view held to the limits the glTF loader
+/// holds positions and cameras to (an orbit about [1e30, 0, 0] put the light
+/// 1e30 m away, fovs of 1e-40 and 1e-20 degrees rendered black or half
+/// black, exit 0), refused with why; and the narrowest fov allowed renders
+/// every pixel lit.
+#[test]
+fn orbit_centres_and_fields_of_view_are_held_to_the_limits() {
+    let dir = temp_dir("desc-limits");
+    write(&dir, "quad.obj", QUAD);
+    let point = |orbit: &str| {
+        format!(
+            r#"{{"mesh": "quad.obj", "lights": [{{"type": "point", "position": [0.5, 2, 0], "orbit": {orbit}}}]}}"#
+        )
+    };
+    let camera = |fields: &str| {
+        format!(r#"{{"mesh": "quad.obj", "camera": {{"position": [0, 1, 3]{fields}}}}}"#)
+    };
+    for (text, what) in [
+        (
+            point(r#"{"period": 4, "center": [1e30, 0, 0]}"#),
+            "light 0: orbit center [1e30, 0.0, 0.0] reaches beyond 1e6 m",
+        ),
+        // A centre within the budget, but a circle through the light that
+        // leaves it.
+        (
+            point(r#"{"period": 4, "center": [-9e5, 0, 0]}"#),
+            "light 0: the orbit about [-900000, 0, 0] reaches 1.800e6 m",
+        ),
+        (
+            camera(r#", "orbit": {"period": 4, "center": [0, -1e30, 0]}"#),
+            "camera: orbit center [0.0, -1e30, 0.0] reaches beyond 1e6 m",
+        ),
+        (
+            camera(r#", "fov": 1e-40"#),
+            "camera: fov 1e-40 (degrees): the vertical field of view must be between 1.15e-4 and",
+        ),
+        (camera(r#", "fov": 1e-20"#), "camera: fov 1e-20 (degrees)"),
+    ] {
+        let p = write(&dir, "bad.scene.json", &text);
+        let e = error(&p);
+        assert!(e.contains(what), "{text}: {e}");
+    }
+    // --camera alike, before a device opens.
+    let e = Isr::tiny(&dir)
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .args(["--camera", "position=0,1,5:fov=1e-20"])
+        .fails();
+    assert!(
+        e.contains("fov 1e-20 (degrees)") && !e.contains("Vulkan"),
+        "{e}"
+    );
+    // Just wider than the narrowest: the built-in box's floor, in the spot's
+    // inner cone, fills the view, lit in every pixel.
+    let fov = isr::scene::MIN_YFOV.to_degrees() * 1.01;
+    let mut scene = isr::scene::cornell::cornell_box();
+    scene.animation = None;
+    let spec =
+        description::parse_camera(&format!("position=0,1,3.4:target=0,0,0.8:fov={fov}")).unwrap();
+    description::apply(&mut scene, &[], Some(&spec)).unwrap();
+    let gpu = common::gpu();
+    let r = common::render(&gpu, &scene, &common::sized("none", 32, 32, 32), 1).readback;
+    let dark = r
+        .direct
+        .iter()
+        .filter(|p| (p[0] + p[1] + p[2]).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+        .count();
+    assert_eq!(dark, 0, "{dark} pixels unlit at fov {fov} degrees");
+}
+
+/// What descriptions got wrong in their messages: a sun direction of
+/// [1e30, -1e30, 0] (its length overflows in f32: refused as pointing
+/// nowhere) and a byte-order mark before the JSON (refused as "line 1
+/// column 1: expected value") load; file text in a message is escaped
+/// and cut short.
+#[test]
+fn directions_of_any_length_a_byte_order_mark_and_escaped_messages() {
+    let dir = temp_dir("desc-text");
+    write(&dir, "quad.obj", QUAD);
+    let p = write(
+        &dir,
+        "sun.scene.json",
+        "\u{feff}{\"mesh\": \"quad.obj\", \"lights\": [{\"type\": \"directional\", \"direction\": [1e30, -1e30, 0]}]}",
+    );
+    let s = load_file(&p, &LoadOptions::default()).unwrap();
+    assert!(
+        s.lights[0]
+            .direction
+            .abs_diff_eq(Vec3::new(1.0, -1.0, 0.0).normalize(), 1e-6),
+        "{:?}",
+        s.lights[0].direction
+    );
+    for (text, shows) in [
+        (
+            // JSON's escape for ESC: the string holds the byte itself.
+            r#"{"mesh": "quad.obj", "up": "\u001b[2J"}"#.to_string(),
+            "up '\\u{1b}[2J'".to_string(),
+        ),
+        (
+            r#"{"mesh": "quad.obj", "\u001b[2J": 1}"#.to_string(),
+            "unknown field `\\u{1b}[2J`".to_string(),
+        ),
+        (
+            format!("{{\"mesh\": \"{}.obj\"}}", "m".repeat(100_000)),
+            "(100004 bytes in all)".to_string(),
+        ),
+    ] {
+        let p = write(&dir, "bad.scene.json", &text);
+        let e = error(&p);
+        assert!(
+            e.contains(&shows) && !e.contains('\u{1b}') && e.len() < 2000,
+            "{} bytes: {}",
+            e.len(),
+            &e[..e.len().min(2000)]
+        );
+    }
 }

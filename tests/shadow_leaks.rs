@@ -30,6 +30,7 @@ fn rendered_and_traced(
             spp: 1,
             seed: 1,
             exposure: 1.0,
+            bounces: isr::bounces::Bounces::ONE,
         },
         |_, _| {},
     );

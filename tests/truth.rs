@@ -6,7 +6,11 @@ mod common;
 
 use common::*;
 use isr::bench::truth::{trace, ShadowMaps};
+use isr::bounces::Bounces;
 use isr::scene::Scene;
+
+/// The truths here are of one bounce, the bench's default.
+const ONE: Bounces = Bounces::ONE;
 
 /// The dense reference of `scene` against its truth at noise `target`:
 /// (relative RMSE, the truth's spp and measured noise, fraction left out).
@@ -14,7 +18,7 @@ fn model_error(gpu: &isr::vk::Gpu, scene: &Scene, target: f64) -> (f64, u32, f64
     let settings = sized("reference", 64, 64, 64);
     let r = render(gpu, scene, &settings, 1);
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
-    let t = trace(scene, &r.readback, &shadows, target, 1, |_, _| {});
+    let t = trace(scene, &r.readback, &shadows, target, 1, ONE, |_, _| {});
     let e = relative_rmse(&r.readback.indirect, &t.image.indirect, &t.mask.mask);
     (e, t.spp, t.noise, t.mask.left_out())
 }
@@ -29,8 +33,8 @@ fn the_truth_measures_its_own_noise() {
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu, &scene, &settings, 1);
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
-    let a = trace(&scene, &r.readback, &shadows, 0.1, 1, |_, _| {});
-    let b = trace(&scene, &r.readback, &shadows, 0.1, 2, |_, _| {});
+    let a = trace(&scene, &r.readback, &shadows, 0.1, 1, ONE, |_, _| {});
+    let b = trace(&scene, &r.readback, &shadows, 0.1, 2, ONE, |_, _| {});
     let apart = relative_rmse(&a.image.indirect, &b.image.indirect, &a.mask.mask);
     let expected = (a.noise * a.noise + b.noise * b.noise).sqrt();
     println!(

@@ -31,6 +31,7 @@ fn floor_receivers(n: u32, s: f32) -> Readback {
         final_radiance: zero.clone(),
         direct: zero.clone(),
         indirect: zero.clone(),
+        bounces: vec![],
         albedo: zero,
         normal: vec![[0.0, 1.0, 0.0, 0.0]; count],
         position,
@@ -193,7 +194,15 @@ fn exact_visibility_brings_the_dense_reference_to_the_truth_in_the_box_with_bloc
     let o = Occluders::new(&scene);
     let exact = gather(&r.readback, &vpls, Some(&o), |_, _| {});
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
-    let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
+    let t = trace(
+        &scene,
+        &r.readback,
+        &shadows,
+        0.03,
+        1,
+        isr::bounces::Bounces::ONE,
+        |_, _| {},
+    );
     let model = |x: &[[f32; 4]]| model_error(x, &t);
     let (with, without) = (model(&exact), model(&r.readback.indirect));
     println!(

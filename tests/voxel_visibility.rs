@@ -187,7 +187,15 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
     }
     assert!(errors[3] < 0.25 * none, "{errors:?} against {none}");
     let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
-    let t = trace(&scene, &r.readback, &shadows, 0.03, 1, |_, _| {});
+    let t = trace(
+        &scene,
+        &r.readback,
+        &shadows,
+        0.03,
+        1,
+        isr::bounces::Bounces::ONE,
+        |_, _| {},
+    );
     let model = |x: &[[f32; 4]]| model_error(x, &t);
     let without = model(&r.readback.indirect);
     println!(

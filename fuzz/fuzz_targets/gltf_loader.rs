@@ -1,8 +1,9 @@
 //! libFuzzer over `isr::scene::gltf_load::load_bytes` and what the renderer
 //! first does with a scene. The first byte picks the file name (`.gltf` or
 //! `.glb`); the rest is the file. URIs resolve in a temporary folder, under
-//! the default (safe) policy. Budgets are tightened so that libFuzzer's
-//! memory limit flags only allocations no budget accounts for.
+//! the default (safe) policy. Budgets are `Limits::FUZZ` (shared with the
+//! stable fuzz tests), so that libFuzzer's memory limit flags only
+//! allocations no budget accounts for.
 #![no_main]
 
 use isr::scene::gltf_load::{load_bytes, LoadOptions};
@@ -18,22 +19,7 @@ fuzz_target!(|data: &[u8]| {
     let name = if pick & 1 == 1 { "f.glb" } else { "f.gltf" };
     let options = LoadOptions {
         allow_outside_uris: false,
-        limits: Limits {
-            scene_file_bytes: 8 << 20,
-            line_bytes: 1 << 20,
-            material_library_bytes: 1 << 20,
-            description_bytes: 1 << 16,
-            buffer_bytes: 8 << 20,
-            image_file_bytes: 1 << 20,
-            texture_dimension: 1024,
-            texture_pixels: 1 << 18,
-            node_visits: 1 << 12,
-            hierarchy_depth: 64,
-            triangles: 1 << 15,
-            vertices: 1 << 15,
-            coordinate: 1e6,
-            min_extent: 1e-6,
-        },
+        limits: Limits::FUZZ,
     };
     if let Ok(scene) = load_bytes(&dir.join(name), file, &options) {
         let _ = scene.bounds();

@@ -381,11 +381,15 @@ pub fn speed_vs_error(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()>
 
 /// `speed_vs_truth.svg/.png`: indirect ms against relative RMSE of the
 /// indirect image against the path-traced truth, over the pixels its mask
-/// keeps, with the dense reference's (section 6.6).
+/// keeps, with the dense reference's (section 6.6); the title says the
+/// truth's bounces.
 pub fn speed_vs_truth(dir: &Path, rows: &[Row], scenes: &[String]) -> Result<()> {
     let (r, c) = legend_grid(scenes.len());
     let size = (480 * c as u32, 400 * r as u32 + 40);
-    let title = "indirect time against error from the path-traced truth (log-log)";
+    let title = &format!(
+        "indirect time against error from {} (log-log)",
+        super::bounces::rows_truth_words(rows)
+    );
     let y = |r: &Row| r.truth.rel_rmse_indirect;
     let label = "relative RMSE against the truth";
     both(

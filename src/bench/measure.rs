@@ -416,6 +416,7 @@ fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameSt
         scene: spec.name.clone(),
         method: s.method.name().into(),
         visibility: visibility::label(s),
+        bounces: super::bounces::label(s),
         label: String::new(),
         is_default: false,
         params: parameter_values(s),

@@ -4,6 +4,7 @@
 //! `report.md` into one folder. Rows are journalled to `rows.jsonl` as they
 //! finish, so an interrupted run resumes where it stopped.
 
+pub mod bounces;
 pub mod charts;
 pub mod files;
 pub mod flip;
@@ -275,9 +276,14 @@ impl BenchArgs {
         // Each pass sets its own (`Plan::passes`); a grid out of range is
         // refused before any work.
         let base = visibility::with(&base, Visibility::None);
+        use crate::settings::params::AnyParam as _;
         if visibilities.contains(&Visibility::Voxels) {
-            use crate::settings::params::AnyParam as _;
             crate::voxel_grid::GRID.check(&base)?;
+        }
+        // The truth's bounces, refused out of range before any work.
+        crate::bounces::BOUNCES.check(&base)?;
+        if let Some(w) = bounces::warning(&base).filter(|_| truth_noise > 0.0) {
+            eprintln!("{w}");
         }
         Ok(Plan {
             scenes: specs,
@@ -322,19 +328,21 @@ impl Plan {
             .truth_noise
             .map_or("no truth".to_string(), |n| format!("truth noise {n}"));
         // With the voxel grid on (`--visibility voxels`), rows are kept
-        // apart from a run's without it, so both can share a directory.
+        // apart from a run's without it, so both can share a directory; so
+        // are rows against a truth of more than one bounce.
         let visibility = match crate::visibility::uses_voxels(b) {
             true => format!("|{}", visibility::label(b)),
             false => String::new(),
         };
         format!(
-            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}{visibility}",
+            "{scene}|{method}|{label}|{}x{}|rsm {}|{} frames|{} timed|{truth}|flicker {}{visibility}{}",
             b.width,
             b.height,
             b.rsm_resolution,
             self.frames,
             self.timing_frames,
-            metrics::FLICKER_MEASURE
+            metrics::FLICKER_MEASURE,
+            bounces::key_suffix(b)
         )
     }
 

@@ -67,9 +67,10 @@ pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio], images: &str) -> Str
         "# isr bench\n\n`{}` on {}: device **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
 (1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
 section 6.2), errors means over frames against the dense reference of the same frame (section 6.1) \
-and against the path-traced truth (section 6.6), flicker over the sequence (section 6.3), FLIP on the \
-tone-mapped final image (section 6.4). Indirect visibility: {} (section 6.7; a row with it is held \
-against the dense reference with it, and the one truth of each frame).{}\n\n",
+and against {} (section 6.6; the GPU methods render one bounce whatever `--bounces` says), flicker \
+over the sequence (section 6.3), FLIP on the tone-mapped final image (section 6.4). Indirect \
+visibility: {} (section 6.7; a row with it is held against the dense reference with it, and the one \
+truth of each frame).{}\n\n",
         o.command,
         o.date,
         o.device,
@@ -79,6 +80,7 @@ against the dense reference with it, and the one truth of each frame).{}\n\n",
         b.rsm_resolution,
         plan.frames,
         plan.timing_frames,
+        super::bounces::rows_truth_words(&o.rows),
         visibilities(&o.rows).join(", "),
         if plan.quick { " Quick run (smoke test)." } else { "" }
     );
@@ -152,8 +154,9 @@ fn model_errors(plan: &Plan, o: &Outcome) -> String {
     let target = plan
         .truth_noise
         .map_or("the target".to_string(), |n| format!("{:.0}%", 100.0 * n));
+    let bounces = plan.bounces().words();
     let mut md = format!("## Model error\n\nThe dense reference (every RSM texel a VPL, no indirect visibility) \
-against the path-traced truth (one bounce with visibility, samples doubled until its own noise is under \
+against the path-traced truth ({bounces} with visibility, samples doubled until its own noise is under \
 {target}, or under less where a truth traced before for a tighter target is reused), over the pixels away \
 from geometric and direct-shadow edges (docs/algorithm.md section 6.6): what every VPL method without \
 visibility shares. A method can read below it where its own errors and the missing occlusion partly \
@@ -226,6 +229,7 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         "quick": plan.quick,
         "scenes": scenes,
         "visibilities": visibilities(&o.rows),
+        "bounces": super::bounces::of_rows(&o.rows),
         "ratios": ratios,
         "rows": o.rows,
     });

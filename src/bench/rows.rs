@@ -19,6 +19,12 @@ pub struct Row {
     /// before the axis; the run fills it in from the row's key.
     #[serde(default)]
     pub visibility: String,
+    /// The bounces of the truth its `truth` errors are against
+    /// (`bench::bounces`: `1`, `3`, `inf`; `--bounces`). The GPU methods
+    /// render one bounce whatever it is. Rows journalled before there was
+    /// a choice were against one bounce.
+    #[serde(default = "one_bounce")]
+    pub bounces: String,
     pub label: String,
     pub is_default: bool,
     /// The value of every parameter the method reads, by option name
@@ -174,6 +180,11 @@ pub fn done_keys(rows: &[Row]) -> HashSet<String> {
     rows.iter().map(|r| r.key.clone()).collect()
 }
 
+fn one_bounce() -> String {
+    use crate::settings::ParamType as _;
+    crate::bounces::Bounces::ONE.text()
+}
+
 fn opt<T: ToString>(v: &Option<T>) -> String {
     v.as_ref().map(T::to_string).unwrap_or_default()
 }
@@ -223,7 +234,7 @@ pub fn pass_names(rows: &[Row]) -> Vec<String> {
 pub fn to_csv(rows: &[Row]) -> String {
     let params = param_names(rows);
     let passes = pass_names(rows);
-    let mut out = String::from("scene,method,visibility,label,is_default");
+    let mut out = String::from("scene,method,visibility,bounces,label,is_default");
     for p in &params {
         out += &format!(",{p}");
     }
@@ -239,6 +250,7 @@ flicker_pixel,gpu_memory_bytes,rel_rmse_truth,truth_spp,truth_noise,truth_left_o
             r.scene.clone(),
             r.method.clone(),
             r.visibility.clone(),
+            r.bounces.clone(),
             format!("\"{}\"", r.label),
             r.is_default.to_string(),
         ];
@@ -291,6 +303,7 @@ pub(crate) mod tests_support {
             scene: "s".into(),
             method: "hisr".into(),
             visibility: "none".into(),
+            bounces: "1".into(),
             label: "tau 0.05, depth 6".into(),
             is_default: true,
             params: [("tau", "0.05"), ("max-depth", "6"), ("visibility", "none")]
@@ -377,11 +390,11 @@ mod tests {
         let csv = to_csv(&[row("a")]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(",gather_ms"));
-        // The visibility is its own column, not a parameter's.
-        assert!(
-            lines[0].starts_with("scene,method,visibility,label,is_default,max-depth,tau,width,")
-        );
-        assert!(lines[1].contains(",hisr,none,\"tau 0.05, depth 6\",true,6,0.05,8,"));
+        // The visibility and the truth's bounces are columns of their own,
+        // not parameters'.
+        assert!(lines[0]
+            .starts_with("scene,method,visibility,bounces,label,is_default,max-depth,tau,width,"));
+        assert!(lines[1].contains(",hisr,none,1,\"tau 0.05, depth 6\",true,6,0.05,8,"));
         assert!(lines[1].ends_with(",1"));
     }
 }

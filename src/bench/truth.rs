@@ -11,6 +11,7 @@
 //!   is found in the light's view, not the camera's: at a grazing light one
 //!   texel can span many pixels.
 
+use crate::bounces::Bounces;
 use crate::readback::Readback;
 use crate::scene::LightKind;
 use crate::view::LightView;
@@ -244,10 +245,12 @@ pub const NOISE_TARGET: f64 = 0.02;
 const FIRST_SPP: u32 = 16;
 pub const MAX_SPP: u32 = 16384;
 
-/// One frame's path-traced truth: its image (the sum of both halves), the
-/// pixels it is compared on, its samples per pixel and measured noise.
+/// One frame's path-traced truth: its image (the sum of both halves, its
+/// layers by bounce included), the pixels it is compared on, its bounces,
+/// samples per pixel and measured noise.
 pub struct Truth {
     pub image: Readback,
+    pub bounces: Bounces,
     pub mask: TruthMask,
     pub spp: u32,
     pub noise: f64,
@@ -265,8 +268,8 @@ impl Truth {
 }
 
 /// Two independent estimates of the indirect image (odd and even seeds),
-/// each a sample-weighted mean; their difference measures the noise of
-/// their mean without knowing the answer.
+/// each a sample-weighted mean (and so their layers by bounce); their
+/// difference measures the noise of their mean without knowing the answer.
 struct Halves {
     a: Readback,
     b: Readback,
@@ -285,6 +288,12 @@ impl Halves {
         };
         mix(&mut self.a.indirect, &a.indirect);
         mix(&mut self.b.indirect, &b.indirect);
+        for (x, y) in self.a.bounces.iter_mut().zip(&a.bounces) {
+            mix(x, y);
+        }
+        for (x, y) in self.b.bounces.iter_mut().zip(&b.bounces) {
+            mix(x, y);
+        }
         self.spp += spp;
     }
 
@@ -309,10 +318,16 @@ impl Halves {
 
     /// Both halves averaged: the image the bench compares with.
     fn mean(mut self) -> Readback {
-        for (p, q) in self.a.indirect.iter_mut().zip(&self.b.indirect) {
-            for c in 0..3 {
-                p[c] = 0.5 * (p[c] + q[c]);
+        let average = |x: &mut Vec<[f32; 4]>, y: &[[f32; 4]]| {
+            for (p, q) in x.iter_mut().zip(y) {
+                for c in 0..3 {
+                    p[c] = 0.5 * (p[c] + q[c]);
+                }
             }
+        };
+        average(&mut self.a.indirect, &self.b.indirect);
+        for (x, y) in self.a.bounces.iter_mut().zip(&self.b.bounces) {
+            average(x, y);
         }
         for (k, f) in self.a.final_radiance.iter_mut().enumerate() {
             let (d, e, rho) = (self.a.direct[k], self.a.indirect[k], self.a.albedo[k]);
@@ -324,16 +339,18 @@ impl Halves {
     }
 }
 
-/// Path-traces `scene` (posed for the frame) at `g`'s size, doubling up the
-/// samples until the noise of its indirect image over the compared pixels
-/// (`truth_mask` of the rasterised G-buffer `g`) is under `target`, or
-/// [`MAX_SPP`] is reached. `progress(spp, noise)` after each pass.
+/// Path-traces `scene` (posed for the frame) at `g`'s size with `bounces`,
+/// doubling up the samples until the noise of its indirect image (every
+/// bounce of it together) over the compared pixels (`truth_mask` of the
+/// rasterised G-buffer `g`) is under `target`, or [`MAX_SPP`] is reached.
+/// `progress(spp, noise)` after each pass.
 pub fn trace(
     scene: &crate::scene::Scene,
     g: &Readback,
     shadows: &ShadowMaps,
     target: f64,
     seed: u64,
+    bounces: Bounces,
     progress: impl Fn(u32, f64),
 ) -> Truth {
     let pass = |spp: u32, s: u64| {
@@ -345,6 +362,7 @@ pub fn trace(
                 spp,
                 seed: s,
                 exposure: 1.0,
+                bounces,
             },
             |_, _| {},
         )
@@ -378,6 +396,7 @@ pub fn trace(
     let spp = 2 * halves.spp;
     Truth {
         image: halves.mean(),
+        bounces,
         mask,
         spp,
         noise,
@@ -416,6 +435,7 @@ mod tests {
             final_radiance: empty.clone(),
             direct: empty.clone(),
             indirect: empty.clone(),
+            bounces: vec![],
             albedo: empty,
             normal,
             position,

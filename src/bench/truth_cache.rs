@@ -1,10 +1,12 @@
 //! The path-traced truth and the exact-visibility floor of each bench frame
 //! (docs/algorithm.md section 6.6), cached in the run's folder
-//! (`truth/SCENE/frame-K.exr` and `exact-K.exr`, each with a JSON note) so
-//! that a run that stops resumes without tracing them again.
+//! (`truth/SCENE/frame-K.exr`, `frame-K-bounces-N.exr` for a truth of N
+//! bounces, and `exact-K.exr`, each with a JSON note) so that a run that
+//! stops resumes without tracing them again.
 
 use super::truth::{self, trace, truth_mask, ShadowMaps, Truth};
 use super::{frame_time, Plan, SceneSpec};
+use crate::bounces::Bounces;
 use crate::readback::Readback;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
@@ -49,10 +51,11 @@ pub(super) fn model_floor(
     Ok(exact.indirect)
 }
 
-/// The path-traced truth of frame `k` of `spec` at the run's noise target,
-/// cached in the run's folder (`truth/SCENE/frame-K.exr`, with a note of
-/// its samples and noise), compared on the pixels of `g` (the reference's
-/// G-buffer, whose RSMs `r` holds) away from edges.
+/// The path-traced truth of frame `k` of `spec` at the run's noise target
+/// and bounces (`--bounces`), cached in the run's folder
+/// (`truth/SCENE/frame-K.exr`, with a note of its bounces, samples and
+/// noise), compared on the pixels of `g` (the reference's G-buffer, whose
+/// RSMs `r` holds) away from edges.
 pub(super) fn frame_truth(
     plan: &Plan,
     spec: &SceneSpec,
@@ -66,8 +69,11 @@ pub(super) fn frame_truth(
         time: frame_time(spec, k),
         target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
         seed: k as u64 + 1,
+        bounces: plan.bounces(),
     };
-    let path = super::files::truth_dir(&plan.out_dir, &spec.name).join(format!("frame-{k}.exr"));
+    let path = super::files::truth_dir(&plan.out_dir, &spec.name)
+        .join(super::bounces::truth_file(k, key.bounces));
+    let what = super::bounces::truth_words(key.bounces);
     let shadows = truth::ShadowMaps::new(
         r.light_views(),
         r.render_origin(),
@@ -76,7 +82,7 @@ pub(super) fn frame_truth(
     );
     let message = |spp: u32, noise: f64| {
         bar.set_message(format!(
-            "{}: path-traced truth, frame {}/{}: {spp} spp, noise {:.1}%",
+            "{}: {what}, frame {}/{}: {spp} spp, noise {:.1}%",
             spec.name,
             k + 1,
             plan.frames,
@@ -89,7 +95,7 @@ pub(super) fn frame_truth(
     if bar.is_hidden() {
         // No terminal (a log, CI): a line per frame, as per row.
         eprintln!(
-            "{}: path-traced truth of frame {}/{}: {} spp, noise {:.4}, {:.1}% of pixels left out",
+            "{}: {what} of frame {}/{}: {} spp, noise {:.4}, {:.1}% of pixels left out",
             spec.name,
             k + 1,
             plan.frames,
@@ -107,9 +113,18 @@ struct CacheNote {
     width: u32,
     height: u32,
     time: f32,
+    /// Its bounces as `--bounces` writes them; a note written before the
+    /// bounces were noted is of one bounce, all the path tracer traced then.
+    #[serde(default = "one_bounce")]
+    bounces: String,
     target: f64,
     spp: u32,
     noise: f64,
+}
+
+fn one_bounce() -> String {
+    use crate::settings::ParamType as _;
+    Bounces::ONE.text()
 }
 
 /// The layer `name` of the EXR `image` as RGBA pixels (alpha 1).
@@ -138,15 +153,20 @@ fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<V
     Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
 }
 
-/// A truth traced before for this frame (`path` and its note), if its size
-/// and time match and it was traced for this noise target or measured under
-/// it; anything else is traced again.
-fn cached(path: &Path, g: &Readback, time: f32, target: f64) -> Option<(Readback, u32, f64)> {
+/// A truth traced before for this frame (`path` and its note), if its size,
+/// time and bounces match and it was traced for this noise target or
+/// measured under it; anything else is traced again. The bounces must
+/// match exactly: a truth of other bounces is another image, and its noise
+/// was measured on that image.
+fn cached(path: &Path, g: &Readback, key: &FrameKey) -> Option<(Readback, u32, f64)> {
+    use crate::settings::ParamType as _;
     let note: CacheNote =
         serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
+    let target = key.target;
     // A truth traced for a tighter target serves a looser one as it is.
     if (note.width, note.height) != (g.width, g.height)
-        || note.time != time
+        || note.time != key.time
+        || note.bounces != key.bounces.text()
         || !(note.target == target || note.noise <= target)
     {
         return None;
@@ -157,22 +177,35 @@ fn cached(path: &Path, g: &Readback, time: f32, target: f64) -> Option<(Readback
     r.direct = layer(&image, "direct", n)?;
     r.indirect = layer(&image, "indirect", n)?;
     r.final_radiance = layer(&image, "final", n)?;
+    let by_bounce: Option<Vec<_>> = crate::bounces::LAYERS[..key.bounces.layers()]
+        .iter()
+        .map(|name| layer(&image, name, n))
+        .collect();
+    r.bounces = match by_bounce {
+        Some(layers) => layers,
+        // Cached before the light was kept by bounce: of one bounce, so
+        // `indirect` is its first bounce.
+        None if key.bounces == Bounces::ONE => vec![r.indirect.clone()],
+        None => return None,
+    };
     Some((r, note.spp, note.noise))
 }
 
 /// Which truth of a scene a bench frame needs: its animation time, the
-/// noise target, and the seed of its first samples.
+/// noise target, the seed of its first samples and its bounces.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameKey {
     pub time: f32,
     pub target: f64,
     pub seed: u64,
+    pub bounces: Bounces,
 }
 
 /// The truth of one bench frame: read from `path` when traced before for
-/// the same size and time, to this noise target or under it, else traced (see [`trace`]) and written
-/// there (an EXR of the path tracer's layers and a JSON note), so that a
-/// run that stops resumes without tracing it again.
+/// the same size, time and bounces, to this noise target or under it, else
+/// traced (see [`trace`]) and written there (an EXR of the path tracer's
+/// layers and a JSON note), so that a run that stops resumes without
+/// tracing it again.
 fn traced_or_cached(
     path: &Path,
     posed: &crate::scene::Scene,
@@ -181,22 +214,29 @@ fn traced_or_cached(
     key: FrameKey,
     progress: impl Fn(u32, f64),
 ) -> anyhow::Result<Truth> {
-    let FrameKey { time, target, seed } = key;
-    if let Some((image, spp, noise)) = cached(path, g, time, target) {
+    if let Some((image, spp, noise)) = cached(path, g, &key) {
         let mask = truth_mask(g, &image.direct, shadows);
         return Ok(Truth {
             image,
+            bounces: key.bounces,
             mask,
             spp,
             noise,
         });
     }
-    let truth = trace(posed, g, shadows, target, seed, progress);
+    let FrameKey {
+        time,
+        target,
+        seed,
+        bounces,
+    } = key;
+    let truth = trace(posed, g, shadows, target, seed, bounces, progress);
     crate::output::write_exr(path, &truth.image)?;
     let note = CacheNote {
         width: g.width,
         height: g.height,
         time,
+        bounces: crate::settings::ParamType::text(bounces),
         target,
         spp: truth.spp,
         noise: truth.noise,
@@ -242,4 +282,79 @@ fn write_exact(path: &Path, r: &Readback, time: f32, rsm: u32) -> anyhow::Result
         &path.with_extension("json"),
         &serde_json::to_string_pretty(&note)?,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::readback::RsmReadback;
+
+    /// A 4x4 image whose every layer holds `v`, without layers by bounce
+    /// (as truths were cached before there were bounces).
+    fn image(v: f32) -> Readback {
+        let n = 16;
+        Readback {
+            width: 4,
+            height: 4,
+            final_radiance: vec![[v; 4]; n],
+            direct: vec![[v; 4]; n],
+            indirect: vec![[v; 4]; n],
+            bounces: vec![],
+            albedo: vec![[v; 4]; n],
+            normal: vec![[0.0, 1.0, 0.0, 0.0]; n],
+            position: vec![[0.0, 0.0, 0.0, 1.0]; n],
+            display: vec![],
+            rsm: RsmReadback {
+                resolution: 0,
+                position: vec![],
+                normal: vec![],
+                flux: vec![],
+            },
+        }
+    }
+
+    #[test]
+    fn a_truth_serves_its_own_bounces_only_and_old_notes_are_of_one_bounce() {
+        let dir = std::env::temp_dir().join(format!("isr-truth-cache-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("frame-0.exr");
+        crate::output::write_exr(&path, &image(0.5)).unwrap();
+        // A note as written before the bounces were noted.
+        let old =
+            r#"{"width": 4, "height": 4, "time": 0.0, "target": 0.1, "spp": 64, "noise": 0.05}"#;
+        std::fs::write(path.with_extension("json"), old).unwrap();
+        let key = |bounces| FrameKey {
+            time: 0.0,
+            target: 0.1,
+            seed: 1,
+            bounces,
+        };
+        let g = image(0.0);
+        let (r, spp, _) = cached(&path, &g, &key(Bounces::ONE)).expect("served as one bounce");
+        assert_eq!(spp, 64);
+        assert_eq!(r.bounces, vec![r.indirect.clone()]);
+        assert!(cached(&path, &g, &key(Bounces::Count(2))).is_none());
+        assert!(cached(&path, &g, &key(Bounces::Infinite)).is_none());
+        // A truth of every bounce, with its layers, serves every bounce
+        // alone, and not one.
+        let mut every = image(0.5);
+        every.bounces = vec![vec![[0.125; 4]; 16]; 4];
+        crate::output::write_exr(&path, &every).unwrap();
+        let note = CacheNote {
+            width: 4,
+            height: 4,
+            time: 0.0,
+            bounces: "inf".into(),
+            target: 0.1,
+            spp: 64,
+            noise: 0.05,
+        };
+        let json = serde_json::to_string(&note).unwrap();
+        std::fs::write(path.with_extension("json"), json).unwrap();
+        let (r, _, _) = cached(&path, &g, &key(Bounces::Infinite)).expect("served");
+        assert_eq!(r.bounces.len(), 4);
+        assert_eq!(r.bounces[3][0][0], 0.125);
+        assert!(cached(&path, &g, &key(Bounces::ONE)).is_none());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -325,7 +325,9 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let mut scene = run.load_scene()?;
     let Some(descriptor) = gpu_method else {
-        for name in run.params.0 .0.keys() {
+        // Of the parameters, the path tracer reads the bounces alone.
+        let bounces = crate::bounces::BOUNCES.name;
+        for name in run.params.0 .0.keys().filter(|&&n| n != bounces) {
             eprintln!("warning: --method pathtrace does not read --{name}; it has no effect");
         }
         // The CPU reference renders the scene posed at --time.

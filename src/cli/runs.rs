@@ -16,14 +16,23 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
     if args.spp == 0 {
         bail!("--spp must be at least 1");
     }
+    use crate::settings::params::AnyParam as _;
+    let bounces = &crate::bounces::BOUNCES;
+    let settings = crate::settings::RenderSettings {
+        params: run.params.0.clone(),
+        ..crate::settings::RenderSettings::DEFAULT
+    };
+    bounces.check(&settings)?;
+    let bounces = bounces.get(&settings);
     let threads = rayon::current_num_threads();
     eprintln!(
-        "path tracing {} ({} triangles) at {}x{}, {} spp, on {threads} CPU threads",
+        "path tracing {} ({} triangles) at {}x{}, {} spp, {}, on {threads} CPU threads",
         scene.name,
         scene.triangle_count(),
         run.width,
         run.height,
-        args.spp
+        args.spp,
+        bounces.words()
     );
     let started = std::time::Instant::now();
     let bar = crate::progress::bar(run.height as u64, "rows");
@@ -35,6 +44,7 @@ pub(super) fn pathtrace(args: &RenderArgs, scene: &scene::Scene) -> Result<()> {
             spp: args.spp,
             seed: args.seed,
             exposure: run.exposure,
+            bounces,
         },
         |done, _rows| bar.set_position(done as u64),
     );

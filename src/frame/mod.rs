@@ -36,6 +36,9 @@ pub struct Setup<'a> {
     pub samplers: &'a Samplers,
     pub scene: &'a SceneGpu,
     pub settings: &'a RenderSettings,
+    /// The voxel grid's surface sums (`voxel_grid::surface`), where the run
+    /// asks for them.
+    pub grid_surface: Option<&'a Buffer>,
 }
 
 /// What a pass records a frame into.

@@ -100,6 +100,13 @@ pub trait Descriptor: Sync {
         false
     }
 
+    /// Whether it reads the surface in the voxel grid's cells
+    /// (`voxel_grid::surface`: area, albedo, normal, centroid), which pass
+    /// `voxel-surface` then sums every frame (`Setup::grid_surface`).
+    fn reads_voxel_surface(&self, _s: &RenderSettings) -> bool {
+        false
+    }
+
     /// Whether `--visibility exact` (the CPU limit) applies to it: the dense
     /// reference only.
     fn takes_exact_visibility(&self) -> bool {
@@ -259,11 +266,18 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
     // The grid is made for the run whenever `--visibility voxels` is set
     // (the viewer may switch to a method that reads it), so it counts
     // whatever the method.
-    let grid = match visibility::uses_voxels(s) {
-        true => voxel_grid::VoxelGrid::bytes(s),
-        false => 0,
-    };
+    let grid = voxel_grid::VoxelGrid::bytes(s, grid_contents(d, s));
     multires + grid + d.memory(s)
+}
+
+/// What a run of `d` with `s` asks of the voxel grid: occupancy with
+/// `--visibility voxels` (whatever the method: the viewer may switch to one
+/// that reads it), the surface in its cells where `d` reads it.
+pub fn grid_contents(d: &dyn Descriptor, s: &RenderSettings) -> voxel_grid::Contents {
+    voxel_grid::Contents {
+        occupancy: visibility::uses_voxels(s),
+        surface: d.reads_voxel_surface(s),
+    }
 }
 
 /// Writes `d`'s fields of the run uniforms for `s`: its capabilities', then
@@ -272,20 +286,26 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
     if d.uses_multires() {
         multires::write_uniforms(s, u);
     }
-    if d.reads_visibility() {
-        voxel_grid::write_uniforms(s, u);
-    }
+    // The grid's side and levels: its passes run for any method that
+    // reads it, by visibility or by its cells' surface.
+    voxel_grid::write_uniforms(s, u);
     d.write_uniforms(s, u);
 }
 
-/// Every parameter of every method, once each, in registry order.
+/// Parameters of a run that no method here reads yet but every command
+/// takes: `--bounces`, which the path tracer and the bench's truth read
+/// (`bounces`). Set for a method that does not read it, it is warned of as
+/// any parameter the method does not read (`unused_params`).
+pub const RUN_PARAMS: &[&dyn AnyParam] = &[&crate::bounces::BOUNCES];
+
+/// Every parameter of every method, once each, in registry order, then
+/// those of [`RUN_PARAMS`] no method reads.
 pub fn all_params() -> Vec<&'static dyn AnyParam> {
     let mut out: Vec<&'static dyn AnyParam> = vec![];
-    for &d in REGISTRY {
-        for p in params_of(d) {
-            if !out.iter().any(|q| q.name() == p.name()) {
-                out.push(p);
-            }
+    let of_methods = REGISTRY.iter().flat_map(|&d| params_of(d));
+    for p in of_methods.chain(RUN_PARAMS.iter().copied()) {
+        if !out.iter().any(|q| q.name() == p.name()) {
+            out.push(p);
         }
     }
     out

@@ -27,7 +27,9 @@ fn rgb_layer(name: &str, w: usize, h: usize, data: &[[f32; 4]]) -> Layer<AnyChan
 
 /// Layers `final`, `direct`, `indirect` (radiance W/(m^2 sr); `indirect` is
 /// the irradiance E in W/m^2 before the albedo/pi of the composite), `albedo`,
-/// `normal` (world, unit) and `depth` (view depth in m; infinity on background).
+/// `normal` (world, unit) and `depth` (view depth in m; infinity on background);
+/// and where the run kept them (the path tracer), the layers of `indirect`
+/// by bounce (`bounces::LAYERS`: `indirect.bounce1` ...), irradiance as it.
 pub fn write_exr(path: &Path, r: &Readback) -> Result<()> {
     let (w, h) = (r.width as usize, r.height as usize);
     let depth: Vec<f32> = r
@@ -35,7 +37,7 @@ pub fn write_exr(path: &Path, r: &Readback) -> Result<()> {
         .iter()
         .map(|p| if p[3] > 0.0 { p[3] } else { f32::INFINITY })
         .collect();
-    let layers = vec![
+    let mut layers = vec![
         rgb_layer("final", w, h, &r.final_radiance),
         rgb_layer("direct", w, h, &r.direct),
         rgb_layer("indirect", w, h, &r.indirect),
@@ -51,6 +53,11 @@ pub fn write_exr(path: &Path, r: &Readback) -> Result<()> {
             )])),
         ),
     ];
+    // The light of each bounce, where the renderer kept it apart, so that
+    // any smaller number of bounces is read from one run.
+    for (name, layer) in crate::bounces::LAYERS.iter().zip(&r.bounces) {
+        layers.push(rgb_layer(name, w, h, layer));
+    }
     let image = Image::from_layers(
         ImageAttributes::new(IntegerBounds::from_dimensions((w, h))),
         layers,

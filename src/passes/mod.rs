@@ -264,19 +264,29 @@ impl ScenePass {
 /// Binds `pipeline` (set 0 the frame set, set 1 the scene's) and draws every
 /// mesh instance `instances` times (a layered draw: one instance per layer).
 pub fn draw_scene(ctx: &FrameContext, pipeline: &Pipeline, scene: &SceneGpu, instances: u32) {
+    draw_scene_with(ctx, pipeline, scene, instances, &[], true);
+}
+
+/// [`draw_scene`] with the pass's own sets after the scene's (sets 2..),
+/// and single-sided materials culled (`cull`) or drawn from both sides.
+pub fn draw_scene_with(
+    ctx: &FrameContext,
+    pipeline: &Pipeline,
+    scene: &SceneGpu,
+    instances: u32,
+    own: &[vk::DescriptorSet],
+    cull: bool,
+) {
     let (gpu, cmd) = (ctx.gpu, ctx.cmd);
     let d = &gpu.device;
+    let mut sets = vec![ctx.frame_set, scene.set.set];
+    sets.extend_from_slice(own);
     unsafe {
-        pipeline.bind(
-            gpu,
-            cmd,
-            vk::PipelineBindPoint::GRAPHICS,
-            &[ctx.frame_set, scene.set.set],
-        );
+        pipeline.bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, &sets);
         d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
         d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
         for draw in &scene.draws {
-            let cull = if draw.double_sided {
+            let cull = if draw.double_sided || !cull {
                 vk::CullModeFlags::NONE
             } else {
                 vk::CullModeFlags::BACK

@@ -208,7 +208,12 @@ impl Bvh {
             Cull::BackFaces => det < 0.0,
             Cull::FrontFaces => det > 0.0,
         };
-        if det.abs() < 1e-12 || (!tri.double_sided && skipped) {
+        // A ray (nearly) in the triangle's plane misses it. The bound scales
+        // with the edges (det is their product): an absolute 1e-12 refused
+        // every triangle of a scene 1e-6 m across, whose edges' products are
+        // about that size, and left `pathtrace` black there.
+        let scale = e1.abs().max_element() * e2.abs().max_element();
+        if det.abs() <= 1e-12 * scale || (!tri.double_sided && skipped) {
             return None;
         }
         let inv = 1.0 / det;

@@ -1,4 +1,4 @@
-//! Method `pathtrace` (docs/algorithm.md sections 1 and 5): a one-bounce diffuse
+//! Method `pathtrace` (docs/algorithm.md sections 1 and 5): a diffuse
 //! reference WITH indirect visibility, on the CPU (all cores, rayon), from the
 //! same lights (every light of the scene: spot, point, directional), camera
 //! and materials as the rasterizer. It shows the error
@@ -10,11 +10,15 @@
 //!   (spot, point; directional: rho/pi * E * max(0, n.l) * V; exact V by a shadow ray)
 //! Indirect irradiance by cosine-weighted hemisphere sampling, `spp` rays:
 //!   E(x) = integral of L_direct(y(w)) cos dw ~= pi / N * sum_k L_direct(y_k)
-//! where y_k is the nearest surface along sample k (occlusion included). The
-//! layers mean what the rasterizer's mean (section 2): `indirect` is E.
+//! where y_k is the nearest surface along sample k (occlusion included): one
+//! bounce, the default. With `--bounces N` (`bounces`) each sample goes on
+//! from y_k as a path, adding the light of bounces 2 to N (section 5.4,
+//! "Bounces"), kept by bounce in layers of their own. The layers mean what
+//! the rasterizer's mean (section 2): `indirect` is E, all bounces together.
 
 pub mod bvh;
 
+use crate::bounces::Bounces;
 use crate::readback::{Readback, RsmReadback};
 use crate::scene::{Light, LightKind, Scene};
 use bvh::{Bvh, Cull, Triangle};
@@ -273,8 +277,9 @@ impl Shading<'_> {
         s.albedo / PI * intensity * cos / r2
     }
 
-    /// Indirect irradiance at `s` from `spp` cosine-weighted one-bounce rays.
-    fn indirect(&self, s: &SurfacePoint, spp: u32, rng: &mut Pcg) -> Vec3 {
+    /// The surface seen from `s` in a cosine-weighted direction drawn from
+    /// `rng` (two uniforms), if any.
+    fn bounce(&self, s: &SurfacePoint, rng: &mut Pcg) -> Option<SurfacePoint> {
         let n = s.normal;
         // An orthonormal basis around n (Duff et al. 2017).
         let sign = 1f32.copysign(n.z);
@@ -283,20 +288,80 @@ impl Shading<'_> {
         let t = Vec3A::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
         let bt = Vec3A::new(b, sign + n.y * n.y * a, -n.y);
         let origin = s.position + n * ray_offset(s.position);
-        let mut sum = Vec3::ZERO;
+        let (u1, u2) = (rng.uniform(), rng.uniform());
+        let r = u1.sqrt();
+        let phi = 2.0 * PI * u2;
+        let dir = (t * (r * phi.cos()) + bt * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
+            .normalize();
+        self.trace(origin, dir)
+    }
+
+    /// Indirect irradiance at `s` from `spp` paths of up to `bounces`
+    /// bounces, by bounce: bounces 1, 2, 3, and 4 to the last
+    /// (docs/algorithm.md section 5.4, "Bounces"). Bounce k of a path that
+    /// reached `y_1 ... y_k` adds `pi rho(y_1) ... rho(y_k-1) L_direct(y_k)`
+    /// (cosine-weighted directions: the pdf's `cos / pi` cancels the
+    /// cosine), so the sum over bounces estimates the Neumann series.
+    fn indirect(
+        &self,
+        s: &SurfacePoint,
+        spp: u32,
+        bounces: Bounces,
+        rng: &mut Pcg,
+    ) -> [Vec3; LAYERS] {
+        let last = bounces.last();
+        let mut sums = [Vec3::ZERO; LAYERS];
         for _ in 0..spp {
-            let (u1, u2) = (rng.uniform(), rng.uniform());
-            let r = u1.sqrt();
-            let phi = 2.0 * PI * u2;
-            let dir = (t * (r * phi.cos()) + bt * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
-                .normalize();
-            if let Some(y) = self.trace(origin, dir) {
-                sum += self.direct(&y);
+            // With one bounce this draws and adds exactly as the one-bounce
+            // estimator before it, so a one-bounce image (and every truth
+            // cached from one) is unchanged bit for bit.
+            let Some(mut y) = self.bounce(s, rng) else {
+                continue;
+            };
+            let mut weight = Vec3::ONE;
+            let mut k = 1;
+            loop {
+                sums[(k as usize).min(LAYERS) - 1] += weight * self.direct(&y);
+                if last == Some(k) {
+                    break;
+                }
+                weight *= y.albedo;
+                // Russian roulette from the fourth bounce on: the path goes
+                // on with probability p = min(max albedo of y, 0.95) and its
+                // weight is divided by p, so the estimate is unbiased. Taking
+                // p from the albedo keeps the surviving weight's factor
+                // rho / p at most 1 (roulette adds no fireflies) and ends
+                // paths soon in dark scenes; the 0.95 cap ends them in a
+                // white room too (at most 20 bounces more on average), so
+                // `inf` is finite. Bounces 1 to 3 are traced in full: their
+                // layers carry no roulette noise.
+                if k >= LAYERS as u32 - 1 {
+                    let p = y.albedo.max_element().min(MAX_SURVIVAL);
+                    if rng.uniform() >= p {
+                        break;
+                    }
+                    weight /= p;
+                }
+                if weight.max_element() <= 0.0 {
+                    break; // a black surface reflects no further bounce
+                }
+                match self.bounce(&y, rng) {
+                    Some(next) => y = next,
+                    None => break,
+                }
+                k += 1;
             }
         }
-        sum * (PI / spp as f32)
+        sums.map(|sum| sum * (PI / spp as f32))
     }
 }
+
+/// The path tracer's layers of indirect light by bounce (`bounces::LAYERS`).
+const LAYERS: usize = crate::bounces::LAYERS.len();
+
+/// The largest probability with which Russian roulette lets a path go on
+/// (see `indirect`).
+const MAX_SURVIVAL: f32 = 0.95;
 
 /// What `render` needs besides the scene.
 /// Its name on the command line: `isr render --method pathtrace` runs it
@@ -305,7 +370,7 @@ pub const NAME: &str = "pathtrace";
 
 /// Its line in `--method`'s help.
 pub const HELP: &str =
-    "One-bounce path tracing with indirect visibility, on the CPU (isr render only).";
+    "Path tracing with indirect visibility (one bounce, or --bounces), on the CPU (isr render only).";
 
 #[derive(Clone, Debug)]
 pub struct PathTraceSettings {
@@ -315,6 +380,8 @@ pub struct PathTraceSettings {
     pub spp: u32,
     pub seed: u64,
     pub exposure: f32,
+    /// Bounces of indirect light (`--bounces`): one, as the GPU methods.
+    pub bounces: Bounces,
 }
 
 /// Renders `scene`; `progress(rows_done, rows)` is called from a helper thread
@@ -335,7 +402,8 @@ pub fn render(
     let forward = Vec3A::from(scene.camera.forward());
     let world_origin = shading.origin;
     let (w, h) = (s.width as usize, s.height as usize);
-    let mut pixels = vec![[[0f32; 4]; 6]; w * h]; // final, direct, indirect, albedo, normal, position
+    // final, direct, indirect, albedo, normal, position, then the bounces'.
+    let mut pixels = vec![[[0f32; 4]; 6 + LAYERS]; w * h];
     let rows_done = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         let done = &rows_done;
@@ -365,17 +433,26 @@ pub fn render(
                 };
                 let mut rng = Pcg::new(s.seed, (y * w + x) as u64);
                 let direct = shading.direct(&hit);
-                let indirect = shading.indirect(&hit, s.spp, &mut rng);
+                let by_bounce = shading.indirect(&hit, s.spp, s.bounces, &mut rng);
+                // Everything after the first hit's direct light: the
+                // bounces' sum (those not traced are 0).
+                let indirect: Vec3 = by_bounce.iter().sum();
                 let final_radiance = direct + hit.albedo / PI * indirect;
                 let depth = (hit.position - eye).dot(forward).max(f32::MIN_POSITIVE);
                 let position = (Vec3::from(hit.position).as_dvec3() + world_origin).as_vec3();
+                let rgb = |v: Vec3| v.extend(1.0).to_array();
+                let [b1, b2, b3, b4] = by_bounce.map(rgb);
                 *out = [
-                    final_radiance.extend(1.0).to_array(),
-                    direct.extend(1.0).to_array(),
-                    indirect.extend(1.0).to_array(),
-                    hit.albedo.extend(1.0).to_array(),
+                    rgb(final_radiance),
+                    rgb(direct),
+                    rgb(indirect),
+                    rgb(hit.albedo),
                     Vec3::from(hit.normal).extend(0.0).to_array(),
                     position.extend(depth).to_array(),
+                    b1,
+                    b2,
+                    b3,
+                    b4,
                 ];
             }
             done.fetch_add(1, Ordering::Relaxed);
@@ -397,6 +474,8 @@ pub fn render(
         final_radiance,
         direct: layer(1),
         indirect: layer(2),
+        // The layers this run traced: bounces beyond its last hold nothing.
+        bounces: (0..s.bounces.layers()).map(|k| layer(6 + k)).collect(),
         albedo: layer(3),
         normal: layer(4),
         position: layer(5),
@@ -409,3 +488,6 @@ pub fn render(
         },
     }
 }
+
+#[cfg(test)]
+mod tests;

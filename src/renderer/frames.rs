@@ -90,6 +90,10 @@ impl Renderer<'_> {
                 if let Some(grid) = self.visibility_pass.as_ref().filter(|_| self.grid_in_use) {
                     grid.record(&ctx(cmds[c], v), p, cube, &self.state.instance_transforms);
                 }
+                // ... and the surface in its cells, where the method reads it.
+                if let Some(surface) = &self.surface_pass {
+                    surface.record(&ctx(cmds[c], v), p);
+                }
                 p.set_label(labels[i].clone());
             }
             self.direct.record(&ctx(cmds[c], v), p);

@@ -126,6 +126,7 @@ impl<'g> Renderer<'g> {
             samplers: &self._samplers,
             scene: &self.scene,
             settings,
+            grid_surface: self.voxel_grid.surface.as_ref(),
         };
         let method = crate::methods::create(&setup)?;
         let passes = (MAX_PASSES + method.submissions() as u32) * self.views.len() as u32;

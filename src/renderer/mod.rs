@@ -24,6 +24,7 @@ use crate::settings::RenderSettings;
 use crate::view::LightView;
 use crate::visibility;
 use crate::vk::profiler::{PassSample, Profiler};
+use crate::voxel_grid::surface::SurfacePass;
 use crate::voxel_grid::{self, VoxelGrid, VoxelizePass};
 
 mod frames;
@@ -83,6 +84,9 @@ pub struct Renderer<'g> {
     /// voxels`, and whether the current method reads it (`grid_in_use`).
     visibility_pass: Option<VoxelizePass>,
     grid_in_use: bool,
+    /// Pass `voxel-surface`, made when the method reads the surface in the
+    /// grid's cells (`Descriptor::reads_voxel_surface`).
+    surface_pass: Option<SurfacePass>,
     /// Point lights' layered cube RSM (made only when the scene has one).
     rsm_cube: Option<CubeRsmPass>,
     method: Box<dyn IndirectMethod>,
@@ -146,7 +150,8 @@ impl<'g> Renderer<'g> {
         // The slots' profilers are sized once the method says how many
         // submissions (repeated passes) its frames take, so the method comes
         // first, made with a provisional frame set of the same layout.
-        let voxel_grid = VoxelGrid::new(gpu, settings, visibility::uses_voxels(settings))?;
+        let contents = crate::methods::grid_contents(descriptor, settings);
+        let voxel_grid = VoxelGrid::new(gpu, settings, contents)?;
         let first = FrameSet::new(
             gpu,
             &run_uniforms,
@@ -160,6 +165,7 @@ impl<'g> Renderer<'g> {
             samplers: &samplers,
             scene: &scene_gpu,
             settings,
+            grid_surface: voxel_grid.surface.as_ref(),
         };
         let method = crate::methods::create(&setup)?;
         let rsm = rsm::new(&setup)?;
@@ -184,6 +190,10 @@ impl<'g> Renderer<'g> {
         let visibility_pass = match visibility::uses_voxels(settings) {
             true => Some(VoxelizePass::new(&setup, &voxel_grid, scene)?),
             false => None,
+        };
+        let surface_pass = match &voxel_grid.surface {
+            Some(surface) => Some(SurfacePass::new(&setup, surface)?),
+            None => None,
         };
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
@@ -210,6 +220,7 @@ impl<'g> Renderer<'g> {
             light_sum,
             visibility_pass,
             grid_in_use,
+            surface_pass,
             rsm_cube,
             method,
             rsm,
@@ -296,6 +307,12 @@ impl<'g> Renderer<'g> {
     /// The voxel visibility grid's buffer (its bits, `shaders/voxel_grid/march.glsl`).
     pub fn voxel_grid(&self) -> Option<&Buffer> {
         self.grid_in_use.then_some(&self.voxel_grid.occupancy)
+    }
+
+    /// The voxel grid's surface sums (`voxel_grid::surface`), where the run
+    /// has them.
+    pub fn voxel_surface(&self) -> Option<&Buffer> {
+        self.voxel_grid.surface.as_ref()
     }
 
     /// The RSMs each frame renders, in order.

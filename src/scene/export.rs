@@ -61,6 +61,11 @@ pub fn to_gltf_json(scene: &Scene) -> Result<String> {
     if !scene.textures.is_empty() {
         bail!("exporting textured scenes is not supported");
     }
+    if scene.origin != glam::DVec3::ZERO {
+        // Its positions are relative to the origin, which glTF's f32
+        // transforms would round again.
+        bail!("exporting a scene stored relative to an origin of its own (far from the world's origin) is not supported");
+    }
     let mut bin = Bin::default();
     let mut meshes = Vec::new();
     for m in &scene.meshes {

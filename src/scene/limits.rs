@@ -48,6 +48,14 @@ pub struct Limits {
     /// well before that its shadow test loses precision (measured on
     /// lavapipe: correct at 1e6 m, degraded at 3e6, black at 1e7).
     pub coordinate: f32,
+    /// Largest texture coordinate (in repeats of the texture, either sign).
+    /// Beyond it a coordinate keeps too few bits for a texel in f32, and at
+    /// 3e38 the rasterizer's interpolation overflows to NaN in every pixel.
+    pub texcoord: f32,
+    /// Materials of a scene (in an OBJ, every `newmtl` of its libraries
+    /// counts, defined or used): one mesh is made per material used, so this
+    /// also bounds the meshes an OBJ makes however often it switches.
+    pub materials: u64,
     /// Smallest extent (the diagonal of the geometry's bounds), in metres.
     /// Images do not depend on a scene's size (`tests/scale.rs`) until its
     /// areas and squared distances near f32's smallest normal numbers:
@@ -67,9 +75,34 @@ impl Limits {
         texture_pixels: 1 << 27,
         node_visits: 1 << 20,
         hierarchy_depth: 256,
-        triangles: 1 << 24,
-        vertices: 1 << 24,
+        triangles: 1 << 20,
+        vertices: 1 << 21,
         coordinate: 1e6,
+        texcoord: 65536.0,
+        materials: 1 << 16,
+        min_extent: 1e-6,
+    };
+
+    /// The tight budgets of the fuzz targets (`fuzz/`) and the stable fuzz
+    /// tests (`tests/fuzz_loader*.rs`): what they allow is small, so an
+    /// allocation no budget accounts for stands out (tests/fuzz_loader.rs
+    /// holds each load to 96 MiB at its peak).
+    pub const FUZZ: Limits = Limits {
+        scene_file_bytes: 8 << 20,
+        line_bytes: 1 << 20,
+        material_library_bytes: 1 << 20,
+        description_bytes: 1 << 16,
+        buffer_bytes: 8 << 20,
+        image_file_bytes: 1 << 20,
+        texture_dimension: 1024,
+        texture_pixels: 1 << 18,
+        node_visits: 1 << 12,
+        hierarchy_depth: 64,
+        triangles: 1 << 15,
+        vertices: 1 << 15,
+        coordinate: 1e6,
+        texcoord: 65536.0,
+        materials: 1 << 10,
         min_extent: 1e-6,
     };
 }
@@ -86,7 +119,11 @@ impl Limits {
         let (lo, hi) = scene
             .bounds()
             .ok_or_else(|| anyhow::anyhow!("the scene has no vertices to render"))?;
-        let reach = lo.abs().max(hi.abs()).max_element();
+        // In world metres: the scene's origin counted in, in f64.
+        let o = scene.origin;
+        let reach = ((o + lo.as_dvec3()).abs())
+            .max((o + hi.as_dvec3()).abs())
+            .max_element() as f32;
         if reach.is_nan() || reach > self.coordinate {
             anyhow::bail!(
                 "the scene is too large: its geometry reaches {reach:.3e} m from the origin; isr renders in 32-bit floats and supports coordinates up to {:.0e} m ({shrink})",

@@ -9,15 +9,24 @@ pub mod animation;
 pub mod cornell;
 pub mod description;
 pub mod export;
+pub mod fuzzing;
+mod geometry;
 pub mod gltf_load;
+mod light_camera;
 pub mod limits;
 pub mod motion;
 pub mod obj_load;
 pub mod one_texture;
+pub mod text;
 mod texture_decode;
 mod uri;
 
+pub use geometry::{compute_normals, cuboid, direction, quad};
 pub use gltf_load::LoadOptions;
+pub use light_camera::{
+    check_yfov, render_origin, render_origin_cell, rigid, Camera, Light, LightKind, SpotLight,
+    MIN_YFOV,
+};
 
 /// What kind of scene file a path names, by its extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,15 +56,29 @@ impl FileKind {
 /// Loads the scene file `path` with the loader its extension names
 /// ([`FileKind`]): glTF, OBJ or a scene description, each under the same
 /// policy and budgets (`options`; docs/security.md).
+///
+/// Every message it returns (the error, the scene's warnings) is passed
+/// through [`text::sanitize`]: whatever bytes of the file a message
+/// quotes, none reaches the terminal raw, and none is longer than a few
+/// lines.
 pub fn load_file(path: &std::path::Path, options: &LoadOptions) -> anyhow::Result<Scene> {
-    match FileKind::of(path) {
+    let loaded = match FileKind::of(path) {
         FileKind::Obj => obj_load::load_with(path, options),
         FileKind::Description => description::load_with(path, options),
         FileKind::Gltf => gltf_load::load_with(path, options),
+    };
+    match loaded {
+        Ok(mut scene) => {
+            for w in &mut scene.warnings {
+                *w = text::sanitize(w);
+            }
+            Ok(scene)
+        }
+        Err(e) => Err(anyhow::anyhow!(text::sanitize(&format!("{e:#}")))),
     }
 }
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 
 /// One vertex as the vertex shaders read it (`shaders/scene.vert`).
 #[repr(C)]
@@ -126,177 +149,21 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
-/// What kind of `KHR_lights_punctual` light (docs/algorithm.md section 2.4).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LightKind {
-    /// A cone: intensity in candela (W/sr), the cones below apply.
-    #[default]
-    Spot,
-    /// All around: intensity in candela (W/sr); the cones are ignored.
-    Point,
-    /// Parallel rays along `direction`: intensity in lux, read as the
-    /// irradiance E (W/m^2) on a surface facing the light; position, cones
-    /// and range are ignored.
-    Directional,
-}
-
-impl LightKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            LightKind::Spot => "spot",
-            LightKind::Point => "point",
-            LightKind::Directional => "directional",
-        }
+/// The origin a loader stores a scene relative to ([`Scene::origin`]),
+/// from its world bounds `lo`, `hi` (f64): zero for a scene whose centre is
+/// within its own extent of the world's origin (every scene built around
+/// it keeps its numbers, bit for bit), else its centre snapped to a grid
+/// whose cell is the power of two at or above its extent. Relative to it,
+/// positions are within an extent of zero and keep the precision they have
+/// at home; snapped, a scene moved by whole cells gets the same numbers.
+pub fn scene_origin(lo: glam::DVec3, hi: glam::DVec3) -> glam::DVec3 {
+    let centre = (lo + hi) * 0.5;
+    let extent = (hi - lo).max_element();
+    if !(extent > 0.0 && centre.is_finite()) || centre.abs().max_element() <= extent {
+        return glam::DVec3::ZERO;
     }
-}
-
-/// A `KHR_lights_punctual` light (docs/algorithm.md sections 2.3 and 2.4).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Light {
-    pub kind: LightKind,
-    pub position: Vec3,
-    /// Unit vector the cone (or the directional light's rays) points along (the node's -Z).
-    pub direction: Vec3,
-    /// Linear RGB color.
-    pub color: Vec3,
-    /// Spot and point: luminous intensity in candela, treated as W/sr.
-    /// Directional: illuminance in lux, treated as irradiance E in W/m^2.
-    pub intensity: f32,
-    /// Radians; attenuation is smooth between inner and outer (spot lights only).
-    pub inner_cone: f32,
-    pub outer_cone: f32,
-    /// Distance cut-off; `None` means none (the extension's default).
-    pub range: Option<f32>,
-}
-
-/// The name most of the code knew the light by, when spot lights were all there was.
-pub type SpotLight = Light;
-
-impl Light {
-    /// The extension's angular attenuation, squared smoothstep between the
-    /// cones; 1 for point and directional lights.
-    pub fn angular_attenuation(&self, cos_angle: f64) -> f64 {
-        if self.kind != LightKind::Spot {
-            return 1.0;
-        }
-        let (scale, offset) = self.cone_scale_offset();
-        let t = (cos_angle * scale as f64 + offset as f64).clamp(0.0, 1.0);
-        t * t
-    }
-
-    /// `lightAngleScale` and `lightAngleOffset` as KHR_lights_punctual defines them.
-    pub fn cone_scale_offset(&self) -> (f32, f32) {
-        let cos_outer = self.outer_cone.cos();
-        let cos_inner = self.inner_cone.cos();
-        let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
-        (scale, -cos_outer * scale)
-    }
-
-    /// Radiant intensity (W/sr) toward world point `p`, per color channel,
-    /// including the range window when a range is set. Spot and point lights.
-    pub fn intensity_toward(&self, p: glam::DVec3) -> glam::DVec3 {
-        let to = p - self.position.as_dvec3();
-        let d = to.length();
-        let cos = to.dot(self.direction.as_dvec3()) / d;
-        let mut i = self.color.as_dvec3() * self.intensity as f64 * self.angular_attenuation(cos);
-        if let Some(range) = self.range {
-            let r = d / range as f64;
-            i *= (1.0 - r.powi(4)).clamp(0.0, 1.0);
-        }
-        i
-    }
-
-    /// Irradiance (W/m^2, per channel) on a surface at `p` facing the light,
-    /// unshadowed: `I(w) / d^2` for spot and point lights, `E` for directional
-    /// ones (docs/algorithm.md section 2.4).
-    pub fn irradiance_facing(&self, p: glam::DVec3) -> glam::DVec3 {
-        match self.kind {
-            LightKind::Directional => self.color.as_dvec3() * self.intensity as f64,
-            _ => self.intensity_toward(p) / (p - self.position.as_dvec3()).length_squared(),
-        }
-    }
-
-    /// Unit vector from `p` toward the light.
-    pub fn direction_from(&self, p: glam::DVec3) -> glam::DVec3 {
-        match self.kind {
-            LightKind::Directional => -self.direction.as_dvec3().normalize(),
-            _ => (self.position.as_dvec3() - p).normalize(),
-        }
-    }
-}
-
-/// A perspective camera looking down its local -Z.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Rotation and translation only ([`rigid`]): a camera's node may be
-    /// scaled (a scene scaled as a whole scales its camera's node too), but
-    /// its field of view and znear are its own, so the view is the node's
-    /// placement without the scale.
-    pub world_from_camera: Mat4,
-    /// Vertical field of view, radians.
-    pub yfov: f32,
-    pub znear: f32,
-}
-
-impl Camera {
-    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, yfov: f32, znear: f32) -> Self {
-        Self {
-            world_from_camera: Mat4::look_at_rh(eye, target, up).inverse(),
-            yfov,
-            znear,
-        }
-    }
-
-    pub fn position(&self) -> Vec3 {
-        self.world_from_camera.w_axis.truncate()
-    }
-
-    pub fn forward(&self) -> Vec3 {
-        (-self.world_from_camera.z_axis.truncate()).normalize()
-    }
-}
-
-/// The rotation and translation of `m`, without its scale: `None` when `m`
-/// is not finite or maps some direction to (nearly) zero (a scale of 0),
-/// so that it has no orientation.
-pub fn rigid(m: Mat4) -> Option<Mat4> {
-    let l = glam::Mat3::from_mat4(m);
-    let lengths = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
-    let det = l.determinant();
-    let regular =
-        lengths.is_finite() && lengths > 0.0 && det.is_finite() && det.abs() > 1e-6 * lengths;
-    if !(regular && m.w_axis.is_finite()) {
-        return None;
-    }
-    let (_, rotation, translation) = m.to_scale_rotation_translation();
-    rotation
-        .is_finite()
-        .then(|| Mat4::from_rotation_translation(rotation.normalize(), translation))
-}
-
-/// The origin the GPU renders relative to, for `camera`: its position
-/// snapped to a grid whose cell is the power of two at or above 64 times
-/// its znear ([`render_origin_cell`]). Positions on the GPU are then what
-/// they would be with the camera near the world's origin, wherever the
-/// scene is, and keep the precision they have there; the origin moves only
-/// when the camera crosses a cell; and a scene moved by whole cells, or
-/// scaled by a power of two (znear with it), renders from exactly the same
-/// (or exactly scaled) numbers.
-pub fn render_origin(camera: &Camera) -> glam::DVec3 {
-    let cell = render_origin_cell(camera.znear);
-    (camera.position().as_dvec3() / cell).round() * cell
-}
-
-/// See [`render_origin`]: the camera is then within 56 znear of the
-/// origin, so geometry it sees (at least znear away) has relative
-/// coordinates no more than about 57 times its distance, a loss of under
-/// 6 bits of float precision at the nearest and less beyond.
-pub fn render_origin_cell(znear: f32) -> f64 {
-    let z = znear as f64 * 64.0;
-    if !(z.is_finite() && z > 0.0) {
-        return 1.0;
-    }
-    2f64.powi(z.log2().ceil() as i32)
+    let cell = 2f64.powi(extent.log2().ceil() as i32);
+    (centre / cell).round() * cell
 }
 
 /// What changes from frame to frame: where the camera and the light are and
@@ -368,6 +235,16 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// What moves over time; `None` for a still scene (and scenes built by code).
     pub animation: Option<animation::Animation>,
+    /// Where the scene's coordinates start, in world metres: every
+    /// position of the scene (vertices through their instances, lights,
+    /// the camera, the animation) is relative to it. Zero unless a loader
+    /// found the scene far from the world's origin for its size
+    /// ([`scene_origin`]): it then composed the file's transforms in f64
+    /// and subtracted this before rounding to f32, so that a scene moved
+    /// by 9e5 m renders as it does at home. Budgets on coordinates count
+    /// it in; the renderer never needs it (images do not depend on where
+    /// the scene is).
+    pub origin: glam::DVec3,
 }
 
 impl Scene {
@@ -383,6 +260,7 @@ impl Scene {
             camera,
             warnings: vec![],
             animation: None,
+            origin: glam::DVec3::ZERO,
         }
     }
 
@@ -509,13 +387,14 @@ impl Scene {
                 continue;
             };
             let mesh = &self.meshes[inst.mesh];
+            // In world metres: the scene's origin counted in, in f64.
             let reach = mesh
                 .vertices
                 .iter()
                 .map(|v| {
-                    m.transform_point3(Vec3::from(v.position))
+                    (self.origin + m.transform_point3(Vec3::from(v.position)).as_dvec3())
                         .abs()
-                        .max_element()
+                        .max_element() as f32
                 })
                 .fold(0.0f32, |r, x| {
                     if x.is_nan() || r.is_nan() {
@@ -547,166 +426,5 @@ impl Scene {
             .iter()
             .map(|i| self.meshes[i.mesh].indices.len() / 3)
             .sum()
-    }
-}
-
-/// Vertices and indices of a planar quad given counter-clockwise from its front.
-pub fn quad(c: [Vec3; 4]) -> (Vec<GpuVertex>, Vec<u32>) {
-    let n = (c[1] - c[0]).cross(c[2] - c[0]).normalize();
-    let uvs = [
-        Vec2::new(0.0, 1.0),
-        Vec2::new(1.0, 1.0),
-        Vec2::new(1.0, 0.0),
-        Vec2::new(0.0, 0.0),
-    ];
-    let vertices = c
-        .iter()
-        .zip(uvs)
-        .map(|(p, uv)| GpuVertex {
-            position: p.to_array(),
-            normal: n.to_array(),
-            uv: uv.to_array(),
-        })
-        .collect();
-    (vertices, vec![0, 1, 2, 0, 2, 3])
-}
-
-/// A closed box with outward faces: `center`, full `size`, turned by `yaw` radians about +Y.
-pub fn cuboid(center: Vec3, size: Vec3, yaw: f32) -> (Vec<GpuVertex>, Vec<u32>) {
-    let rot = glam::Quat::from_rotation_y(yaw);
-    let h = size * 0.5;
-    let corner = |x: f32, y: f32, z: f32| center + rot * Vec3::new(x * h.x, y * h.y, z * h.z);
-    // Each face counter-clockwise seen from outside.
-    let faces = [
-        [
-            corner(-1., -1., 1.),
-            corner(1., -1., 1.),
-            corner(1., 1., 1.),
-            corner(-1., 1., 1.),
-        ], // +z
-        [
-            corner(1., -1., -1.),
-            corner(-1., -1., -1.),
-            corner(-1., 1., -1.),
-            corner(1., 1., -1.),
-        ], // -z
-        [
-            corner(1., -1., 1.),
-            corner(1., -1., -1.),
-            corner(1., 1., -1.),
-            corner(1., 1., 1.),
-        ], // +x
-        [
-            corner(-1., -1., -1.),
-            corner(-1., -1., 1.),
-            corner(-1., 1., 1.),
-            corner(-1., 1., -1.),
-        ], // -x
-        [
-            corner(-1., 1., 1.),
-            corner(1., 1., 1.),
-            corner(1., 1., -1.),
-            corner(-1., 1., -1.),
-        ], // +y
-        [
-            corner(-1., -1., -1.),
-            corner(1., -1., -1.),
-            corner(1., -1., 1.),
-            corner(-1., -1., 1.),
-        ], // -y
-    ];
-    let mut vertices = Vec::new();
-    let mut indices = Vec::new();
-    for f in faces {
-        let (v, i) = quad(f);
-        let base = vertices.len() as u32;
-        vertices.extend(v);
-        indices.extend(i.into_iter().map(|i| i + base));
-    }
-    (vertices, indices)
-}
-
-/// Face normals accumulated per vertex, for primitives without NORMAL.
-/// The factor that scales `vertices` to about unit size (1 when they are
-/// all at the origin or not finite), for cross products of their edges: at
-/// 1e18 m one (1e36) would overflow when normalised. One scale for the
-/// whole mesh keeps the area weights' ratios.
-pub(crate) fn unit_scale(vertices: &[GpuVertex]) -> f32 {
-    let extent = vertices
-        .iter()
-        .flat_map(|v| v.position)
-        .fold(0f32, |m, c| m.max(c.abs()));
-    if extent > 0.0 && extent.is_finite() {
-        1.0 / extent
-    } else {
-        1.0
-    }
-}
-
-pub fn compute_normals(vertices: &mut [GpuVertex], indices: &[u32]) {
-    // Positions scaled to about unit size first (`unit_scale`).
-    let scale = unit_scale(vertices);
-    let mut acc = vec![Vec3::ZERO; vertices.len()];
-    for t in indices.chunks_exact(3) {
-        let p = |k: usize| Vec3::from(vertices[t[k] as usize].position) * scale;
-        // Area-weighted: the cross product's length is twice the area.
-        let n = (p(1) - p(0)).cross(p(2) - p(0));
-        for &k in t {
-            acc[k as usize] += n;
-        }
-    }
-    for (v, n) in vertices.iter_mut().zip(acc) {
-        v.normal = n.normalize_or(Vec3::Y).to_array();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cuboid_faces_point_outward() {
-        let center = Vec3::new(0.3, 0.5, -0.2);
-        let (v, i) = cuboid(center, Vec3::new(0.6, 1.0, 0.4), 0.7);
-        for t in i.chunks_exact(3) {
-            let p = |k: usize| Vec3::from(v[t[k] as usize].position);
-            let n = (p(1) - p(0)).cross(p(2) - p(0));
-            assert!(n.dot(p(0) - center) > 0.0, "face winding points inward");
-            assert!(n
-                .normalize()
-                .abs_diff_eq(Vec3::from(v[t[0] as usize].normal), 1e-5));
-        }
-    }
-
-    #[test]
-    fn spot_attenuation_follows_khr_lights_punctual() {
-        let l = SpotLight {
-            kind: LightKind::Spot,
-            position: Vec3::ZERO,
-            direction: -Vec3::Y,
-            color: Vec3::ONE,
-            intensity: 1.0,
-            inner_cone: 0.3,
-            outer_cone: 0.6,
-            range: None,
-        };
-        assert_eq!(l.angular_attenuation(1.0), 1.0);
-        assert!((l.angular_attenuation(0.3f64.cos()) - 1.0).abs() < 1e-6);
-        assert_eq!(l.angular_attenuation(0.7f64.cos()), 0.0);
-        // Halfway in cosine between the cones: (1/2)^2.
-        let mid = 0.5 * (0.3f64.cos() + 0.6f64.cos());
-        assert!((l.angular_attenuation(mid) - 0.25).abs() < 1e-4);
-    }
-
-    #[test]
-    fn computed_normals_of_a_flat_quad_are_its_normal() {
-        let (mut v, i) = quad([Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, -1.0), -Vec3::Z]);
-        for x in &mut v {
-            x.normal = [0.0; 3];
-        }
-        compute_normals(&mut v, &i);
-        assert!(v
-            .iter()
-            .all(|x| Vec3::from(x.normal).abs_diff_eq(Vec3::Y, 1e-6)));
     }
 }

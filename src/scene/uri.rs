@@ -12,6 +12,7 @@
 //! more bytes than the caller's bound.
 
 use super::limits;
+use crate::scene::text;
 use anyhow::{anyhow, bail, Result};
 use base64::Engine as _;
 use std::io::Read as _;
@@ -106,14 +107,18 @@ pub fn resolve(uri: &str, base: &Path, allow_outside: bool) -> Result<Source> {
     }
     // Symbolic links: where the path really is must be inside where the
     // folder really is.
-    let real =
-        std::fs::canonicalize(&path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-    let real_base = std::fs::canonicalize(base)
-        .map_err(|e| anyhow!("cannot resolve the scene's folder {}: {e}", base.display()))?;
+    let real = std::fs::canonicalize(&path)
+        .map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
+    let real_base = std::fs::canonicalize(base).map_err(|e| {
+        anyhow!(
+            "cannot resolve the scene's folder {}: {e}",
+            text::path(&base)
+        )
+    })?;
     if !real.starts_with(&real_base) {
         bail!(
             "{} resolves (through a symbolic link) to outside the scene file's folder: {HOW_TO_ALLOW}",
-            path.display()
+            text::path(&path)
         );
     }
     Ok(Source::File(real))
@@ -195,23 +200,23 @@ pub(super) fn kind(t: std::fs::FileType) -> &'static str {
 /// Returns the file and its length.
 fn open_regular(path: &Path) -> Result<(std::fs::File, u64)> {
     let meta =
-        std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     if !meta.is_file() {
         bail!(
             "{} is {}: only regular files are read",
-            path.display(),
+            text::path(&path),
             kind(meta.file_type())
         );
     }
     let file =
-        std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     let meta = file
         .metadata()
-        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        .map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     if !meta.is_file() {
         bail!(
             "{} is {}: only regular files are read",
-            path.display(),
+            text::path(&path),
             kind(meta.file_type())
         );
     }
@@ -228,7 +233,7 @@ pub fn read_prefix(path: &Path, len: u64, what: &str) -> Result<Vec<u8>> {
     let mut data = Vec::with_capacity(len as usize);
     file.take(len)
         .read_to_end(&mut data)
-        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        .map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     if (data.len() as u64) < len {
         bail!(
             "{what} has {} bytes but the file declares byteLength {len}: the buffer is truncated",
@@ -255,7 +260,7 @@ pub fn read_capped(path: &Path, max: u64, what: &str) -> Result<Vec<u8>> {
     // One byte more than allowed tells a file that grew after the check.
     file.take(max + 1)
         .read_to_end(&mut data)
-        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        .map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     if data.len() as u64 > max {
         return Err(too_big(data.len() as u64));
     }

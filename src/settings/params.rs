@@ -179,6 +179,13 @@ pub trait ParamType: Copy + PartialEq + 'static {
     fn names() -> Option<Vec<&'static str>> {
         None
     }
+    /// `--help`'s value name: the possible values (`on|off`), or `N`.
+    fn value_name() -> String {
+        match Self::names() {
+            Some(n) => n.join("|"),
+            None => "N".into(),
+        }
+    }
 }
 
 impl ParamType for f32 {
@@ -390,10 +397,7 @@ impl<T: ParamType + Sync> AnyParam for Param<T> {
         }
     }
     fn value_name(&self) -> String {
-        match T::names() {
-            Some(n) => n.join("|"),
-            None => "N".into(),
-        }
+        T::value_name()
     }
     fn parse(&self, text: &str) -> Result<Value, String> {
         Ok(T::parse(text)?.to_value())

@@ -26,6 +26,7 @@ use ash::vk;
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 
+pub mod surface;
 mod triangle_order;
 mod voxelize;
 pub use triangle_order::TriangleOrder;
@@ -149,27 +150,63 @@ pub struct VoxelGrid {
     /// Occupancy: a bit per cell of every level, and a mask of sub-cells per
     /// finest cell with `--visibility-subcells` 2 or 4.
     pub occupancy: Buffer,
+    /// The surface inside each finest cell (`surface`), for the passes that
+    /// read it.
+    pub surface: Option<Buffer>,
+}
+
+/// What a run asks of the grid.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Contents {
+    /// Occupancy, for visibility.
+    pub occupancy: bool,
+    /// The surface inside each cell (`surface`).
+    pub surface: bool,
+}
+
+impl Contents {
+    pub fn any(self) -> bool {
+        self.occupancy || self.surface
+    }
 }
 
 impl VoxelGrid {
-    /// The grid of `s` if `wanted` (a pass reads it), or its stand-in.
-    pub fn new(gpu: &Gpu, s: &RenderSettings, wanted: bool) -> Result<Self> {
+    /// The grid of `s` with `contents`; occupancy is a 16-byte stand-in
+    /// when nothing reads the grid (the frame set binds it always).
+    pub fn new(gpu: &Gpu, s: &RenderSettings, contents: Contents) -> Result<Self> {
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_DST
+            | vk::BufferUsageFlags::TRANSFER_SRC;
         let occupancy = Buffer::new(
             gpu,
             "voxel grid occupancy",
-            if wanted { bytes(s) } else { 16 },
-            vk::BufferUsageFlags::STORAGE_BUFFER
-                | vk::BufferUsageFlags::TRANSFER_DST
-                | vk::BufferUsageFlags::TRANSFER_SRC,
+            if contents.any() { bytes(s) } else { 16 },
+            usage,
             MemoryLocation::GpuOnly,
         )?;
-        Ok(Self { occupancy })
+        let surface = match contents.surface {
+            true => Some(Buffer::new(
+                gpu,
+                "voxel grid surface",
+                surface::bytes(s),
+                usage,
+                MemoryLocation::GpuOnly,
+            )?),
+            false => None,
+        };
+        Ok(Self { occupancy, surface })
     }
 
-    /// Bytes of every buffer of the grid of `s` (the memory check's count,
-    /// before anything is allocated).
-    pub fn bytes(s: &RenderSettings) -> u64 {
-        bytes(s)
+    /// Bytes of every buffer of the grid of `s` with `contents` (the memory
+    /// check's count, before anything is allocated).
+    pub fn bytes(s: &RenderSettings, contents: Contents) -> u64 {
+        let occupancy = if contents.any() { bytes(s) } else { 0 };
+        let surface = if contents.surface {
+            surface::bytes(s)
+        } else {
+            0
+        };
+        occupancy + surface
     }
 }
 

@@ -58,7 +58,7 @@ impl<'g> Probe<'g> {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )
         .unwrap();
-        let grid = isr::voxel_grid::VoxelGrid::new(gpu, settings, false).unwrap();
+        let grid = isr::voxel_grid::VoxelGrid::new(gpu, settings, Default::default()).unwrap();
         let frame = FrameSet::new(gpu, &run, &grid.occupancy, scene.instances.len()).unwrap();
         let samplers = Samplers::new(gpu).unwrap();
         let lpv = Lpv::new(&Setup {
@@ -68,6 +68,7 @@ impl<'g> Probe<'g> {
             samplers: &samplers,
             scene: &renderer.scene,
             settings,
+            grid_surface: None,
         })
         .expect("lpv");
         Self {

@@ -21,6 +21,7 @@ pub fn from_gltf(
     doc: &gltf::Document,
     buffers: &[Vec<u8>],
     bound: &NodeBindings,
+    origin: glam::DVec3,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Animation>> {
     let skins = doc.skins().count();
@@ -129,17 +130,30 @@ pub fn from_gltf(
     }
     let affected = |k: usize| affected[k] == Some(true);
     let local = |k: usize| Mat4::from_cols_array_2d(&nodes[k].transform().matrix());
-    // World transform of a static node, composed root first as the loader does.
+    // World transform of a static node, composed root first as the loader
+    // does: in f32, or in f64 relative to the scene's origin where it has
+    // one (`Scene::origin`).
     let rest_world = |k: usize| {
         let mut chain = vec![k];
         while let Some(p) = parent[chain[chain.len() - 1]] {
             chain.push(p);
         }
+        if origin == glam::DVec3::ZERO {
+            return chain
+                .iter()
+                .rev()
+                .fold(Mat4::IDENTITY, |w, &n| w * local(n));
+        }
         chain
             .iter()
             .rev()
-            .fold(Mat4::IDENTITY, |w, &n| w * local(n))
+            .fold(glam::DMat4::from_translation(-origin), |w, &n| {
+                w * local(n).as_dmat4()
+            })
+            .as_mat4()
     };
+    // Above a root node: the world, relative to the scene's origin.
+    let root = glam::DMat4::from_translation(-origin).as_mat4();
 
     let mut anim = Animation::default();
     let mut slot: Vec<Option<usize>> = vec![None; count];
@@ -150,7 +164,7 @@ pub fn from_gltf(
         let mut m = Some(n);
         let mut above = loop {
             let Some(k) = m else {
-                break Parent::Fixed(Mat4::IDENTITY);
+                break Parent::Fixed(root);
             };
             if let Some(s) = slot[k] {
                 break Parent::Node(s);

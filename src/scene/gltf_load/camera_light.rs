@@ -4,9 +4,8 @@
 use super::*;
 
 /// A perspective camera, refused when it cannot give an image: a singular
-/// node transform (scale 0), a yfov outside (0, pi) or so close to an end
-/// that its tangent is 0 or infinite, a znear that is not a positive normal
-/// float. `check_znear` relates znear to the scene once bounds are known.
+/// node transform (scale 0), a yfov outside what `check_yfov` allows, a
+/// znear that is not a positive normal float. `check_znear` relates znear to the scene once bounds are known.
 pub(super) fn read_camera(
     index: usize,
     node: usize,
@@ -14,9 +13,11 @@ pub(super) fn read_camera(
     world: Mat4,
 ) -> Result<Camera> {
     let (yfov, znear) = (p.yfov(), p.znear());
-    let f = 1.0 / (0.5 * yfov).tan();
-    if !(yfov > 0.0 && yfov < std::f32::consts::PI && f.is_finite() && f > 1e-6) {
-        bail!("camera {index}: yfov {yfov} must be within (0, pi) radians");
+    if let Err(why) = crate::scene::check_yfov(yfov) {
+        bail!(
+            "camera {index}: yfov {} radians: {why}",
+            crate::scene::text::number(yfov)
+        );
     }
     if !(znear.is_normal() && znear > 0.0) {
         bail!("camera {index}: znear {znear} must be a positive, finite, normal number");

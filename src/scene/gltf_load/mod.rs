@@ -15,7 +15,7 @@ use super::{
     compute_normals, uri, Camera, GpuVertex, Instance, Material, Mesh, Scene, SpotLight, Texture,
 };
 use anyhow::{anyhow, bail, Context as _, Result};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
 use std::path::Path;
@@ -94,6 +94,13 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     // Budgets first: nothing below allocates more than they allow.
     let plan = measure(doc, &scene)?;
     plan.check(limits)?;
+    let materials = doc.materials().len() as u64;
+    if materials > limits.materials {
+        bail!(
+            "the file has {materials} materials; the limit is {}",
+            limits.materials
+        );
+    }
     let buffers = load_buffers(doc, &base, blob.as_deref(), options)?;
     let mut warnings = Vec::new();
 
@@ -114,16 +121,26 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     let mut camera: Option<(usize, usize, Camera)> = None;
     let mut bound = super::animation::NodeBindings::default();
 
-    // `measure` has bounded the visits and ruled out cycles.
-    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-    while let Some((node, parent)) = stack.pop() {
+    // `measure` has bounded the visits and ruled out cycles. Each world
+    // transform is composed twice: in f32, as it always was (what a scene
+    // near the world's origin keeps, bit for bit), and in f64, which a
+    // scene far from it is stored from, relative to its origin (below).
+    let mut stack: Vec<(gltf::Node, Mat4, DMat4)> = scene
+        .nodes()
+        .map(|n| (n, Mat4::IDENTITY, DMat4::IDENTITY))
+        .collect();
+    let mut worlds: Vec<DMat4> = Vec::new();
+    let mut light_nodes: Vec<(gltf::khr_lights_punctual::Light, usize, Mat4, DMat4)> = Vec::new();
+    let mut camera_nodes = Vec::new();
+    while let Some((node, parent, parent64)) = stack.pop() {
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
+        let world64 = parent64 * local.as_dmat4();
         if !world.is_finite() {
             bail!("node {} has a non-finite transform", node.index());
         }
         for child in node.children() {
-            stack.push((child, world));
+            stack.push((child, world, world64));
         }
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
@@ -146,8 +163,14 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
                                 m
                             }
                         };
-                        let loaded =
-                            load_primitive(&mesh, &prim, &buffers, material, &mut warnings)?;
+                        let loaded = load_primitive(
+                            &mesh,
+                            &prim,
+                            &buffers,
+                            material,
+                            limits,
+                            &mut warnings,
+                        )?;
                         loaded.map(|m| {
                             out.meshes.push(m);
                             mesh_ids.insert(key, out.meshes.len() - 1);
@@ -160,35 +183,56 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
                         mesh: id,
                         world_from_object: world,
                     });
+                    worlds.push(world64);
                     bound.instances.push(node.index());
                 }
             }
         }
         if let Some(l) = node.light() {
-            // Every light node is a light (a light instanced by two nodes
-            // shines from both); ordered by node below, so the order is the
-            // file's and not the traversal's.
-            lights.push((node.index(), read_light(&l, world)?));
+            light_nodes.push((l, node.index(), world, world64));
         }
         if let Some(c) = node.camera() {
-            match c.projection() {
-                gltf::camera::Projection::Perspective(p) => {
-                    let cam = read_camera(c.index(), node.index(), &p, world)?;
-                    // "The first perspective camera": lowest camera index.
-                    if camera.as_ref().is_none_or(|(i, _, _)| c.index() < *i) {
-                        camera = Some((c.index(), node.index(), cam));
-                        bound.camera = Some(node.index());
-                    }
-                }
-                gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
-                    "camera {} skipped: orthographic cameras are not supported",
-                    c.index()
-                )),
-            }
+            camera_nodes.push((c, node.index(), world, world64));
         }
     }
     if out.instances.is_empty() {
         bail!("the scene has no triangle geometry to render");
+    }
+    // Far from the world's origin for its size, the scene is stored relative
+    // to an origin of its own, from the f64 transforms.
+    out.origin = origin_of(&out, &worlds);
+    let origin = out.origin;
+    let place = |world: Mat4, world64: DMat4| {
+        if origin == DVec3::ZERO {
+            world
+        } else {
+            (DMat4::from_translation(-origin) * world64).as_mat4()
+        }
+    };
+    for (inst, world64) in out.instances.iter_mut().zip(&worlds) {
+        inst.world_from_object = place(inst.world_from_object, *world64);
+    }
+    for (l, node, world, world64) in light_nodes {
+        // Every light node is a light (a light instanced by two nodes
+        // shines from both); ordered by node below, so the order is the
+        // file's and not the traversal's.
+        lights.push((node, read_light(&l, place(world, world64))?));
+    }
+    for (c, node, world, world64) in camera_nodes {
+        match c.projection() {
+            gltf::camera::Projection::Perspective(p) => {
+                let cam = read_camera(c.index(), node, &p, place(world, world64))?;
+                // "The first perspective camera": lowest camera index.
+                if camera.as_ref().is_none_or(|(i, _, _)| c.index() < *i) {
+                    camera = Some((c.index(), node, cam));
+                    bound.camera = Some(node);
+                }
+            }
+            gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
+                "camera {} skipped: orthographic cameras are not supported",
+                c.index()
+            )),
+        }
     }
     let (lo, hi) = limits.check_extent(&out, "scale the scene down")?;
     lights.sort_by_key(|&(node, _)| node);
@@ -196,7 +240,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         let l = fitted_light(lo, hi);
         warnings.push(format!(
             "no KHR_lights_punctual light: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd)",
-            l.position.to_array(),
+            (origin + l.position.as_dvec3()).to_array(),
             l.intensity
         ));
         out.lights = vec![l];
@@ -217,9 +261,24 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             );
         }
     }
-    out.animation = super::animation::from_gltf(doc, &buffers, &bound, &mut warnings)?;
+    out.animation = super::animation::from_gltf(doc, &buffers, &bound, origin, &mut warnings)?;
     out.warnings = warnings;
     Ok(out)
+}
+
+/// The scene's origin (`scene_origin`) from its world bounds in f64: each
+/// instance's vertices through its f64 world transform `worlds[i]`.
+fn origin_of(scene: &Scene, worlds: &[DMat4]) -> DVec3 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for (inst, world) in scene.instances.iter().zip(worlds) {
+        for v in &scene.meshes[inst.mesh].vertices {
+            let p = world.transform_point3(Vec3::from(v.position).as_dvec3());
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    crate::scene::scene_origin(lo, hi)
 }
 
 fn load_buffers(
@@ -293,6 +352,7 @@ fn load_primitive(
     prim: &gltf::Primitive,
     buffers: &[Vec<u8>],
     material: usize,
+    limits: &Limits,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Mesh>> {
     let label = format!(
@@ -416,6 +476,12 @@ fn load_primitive(
         for (i, (v, uv)) in vertices.iter_mut().zip(uvs).enumerate() {
             if !uv.iter().all(|c| c.is_finite()) {
                 bail!("{label}: vertex {i} has a non-finite TEXCOORD_0 {uv:?}");
+            }
+            if uv.iter().any(|c| c.abs() > limits.texcoord) {
+                bail!(
+                    "{label}: vertex {i} has the TEXCOORD_0 {uv:?}; isr supports texture coordinates up to {} (repeats of the texture): beyond, 32-bit floats keep too few bits for a texel",
+                    limits.texcoord
+                );
             }
             v.uv = uv;
         }

@@ -1,46 +1,47 @@
-//! Every line of an OBJ file, checked by isr before tobj parses it: the
-//! reader tobj pulls from ([`Checked`]) reads one line of the source at a
-//! time (at most `Limits::line_bytes`), checks it, counts what it adds
-//! against the budgets, and hands tobj the line in a plain form (absolute
-//! indices, three coordinates, comments and ignored statements as empty
-//! lines). So an error names its line, a budget stops the read as soon as
-//! it is passed (a file of 10^8 `v` lines is refused after `vertices` of
-//! them, never read whole), and tobj never sees what it would misread: an
-//! index of 0 (which wraps around in tobj), a face index out of range
-//! (reported by tobj only when the object ends), positions with colours on
-//! some lines only, `l` lines (which tobj reads as faces).
+//! Every line of an OBJ file, read and checked one at a time: [`Lines`]
+//! reads a line of the source (at most `Limits::line_bytes`; lines end in
+//! LF, CRLF or a lone CR; a byte-order mark before the first keyword is
+//! dropped), [`line`] checks it and adds what it defines to the state:
+//! positions, texture coordinates and normals as they come, and each face
+//! fanned into triangles straight into the mesh of its material
+//! (`super::assemble`), its distinct vertices counted against the budget as
+//! they appear. So an error names its line, a budget stops the read at the
+//! line that passes it (a file of 10^8 `v` lines is refused after
+//! `vertices` of them, never read whole), and nothing is held per line,
+//! per group or per material switch beyond the geometry itself.
 
 use super::State;
+use crate::scene::limits;
+use crate::scene::text::quote;
 use anyhow::{anyhow, bail, Result};
-use std::cell::RefCell;
-use std::io::{BufRead, Read};
+use glam::Vec3;
+use std::io::BufRead;
 
-/// The reader tobj parses: the checked lines of `src`.
-pub(super) struct Checked<'a, R> {
+/// The lines of a source, read one at a time.
+pub(super) struct Lines<R> {
     src: R,
     raw: Vec<u8>,
-    out: Vec<u8>,
-    pos: usize,
-    state: &'a RefCell<State>,
-    /// Bytes taken from `src` (what a lazy source was asked for).
-    pub(super) bytes: u64,
+    /// A line ended in CR: a LF right after it is the same line end.
+    skip_lf: bool,
+    first: bool,
+    /// Bytes taken from the source (what a lazy source was asked for).
+    pub bytes: u64,
 }
 
-impl<'a, R: BufRead> Checked<'a, R> {
-    pub(super) fn new(src: R, state: &'a RefCell<State>) -> Self {
+impl<R: BufRead> Lines<R> {
+    pub(super) fn new(src: R) -> Self {
         Self {
             src,
             raw: Vec::new(),
-            out: Vec::new(),
-            pos: 0,
-            state,
+            skip_lf: false,
+            first: true,
             bytes: 0,
         }
     }
 
-    /// The next line of the source into `raw` (without its end of line);
-    /// false at the end of the file.
-    fn next_line(&mut self, max: u64) -> Result<bool> {
+    /// The next line without its end, or `None` at the end of the source.
+    /// A line over `max` bytes is an error, found before it is held whole.
+    pub(super) fn next(&mut self, max: u64) -> Result<Option<&[u8]>> {
         self.raw.clear();
         let mut any = false;
         loop {
@@ -51,84 +52,47 @@ impl<'a, R: BufRead> Checked<'a, R> {
             if buf.is_empty() {
                 break;
             }
+            if std::mem::take(&mut self.skip_lf) && buf[0] == b'\n' {
+                self.src.consume(1);
+                self.bytes += 1;
+                continue;
+            }
             any = true;
-            let (take, done) = match buf.iter().position(|&b| b == b'\n') {
-                Some(i) => (i + 1, true),
-                None => (buf.len(), false),
-            };
-            let keep = if done { take - 1 } else { take };
+            let end = buf.iter().position(|&b| b == b'\n' || b == b'\r');
+            let keep = end.unwrap_or(buf.len());
             if (self.raw.len() + keep) as u64 > max {
                 bail!(
                     "the line is longer than {}, the limit for one line",
-                    super::limits::bytes(max)
+                    limits::bytes(max)
                 );
             }
             self.raw.extend_from_slice(&buf[..keep]);
+            let take = match end {
+                Some(i) => {
+                    self.skip_lf = buf[i] == b'\r';
+                    i + 1
+                }
+                None => keep,
+            };
             self.src.consume(take);
             self.bytes += take as u64;
-            if done {
+            if end.is_some() {
                 break;
             }
         }
-        if self.raw.last() == Some(&b'\r') {
-            self.raw.pop();
+        if !any {
+            return Ok(None);
         }
-        Ok(any)
-    }
-}
-
-impl<R: BufRead> Read for Checked<'_, R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let available = self.fill_buf()?;
-        let n = available.len().min(buf.len());
-        buf[..n].copy_from_slice(&available[..n]);
-        self.consume(n);
-        Ok(n)
-    }
-}
-
-impl<R: BufRead> BufRead for Checked<'_, R> {
-    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        while self.pos == self.out.len() {
-            // An error found earlier (here, or while a library was read)
-            // ends tobj's read.
-            if self.state.borrow().error.is_some() {
-                return Err(std::io::Error::other("stopped by isr's check"));
-            }
-            self.out.clear();
-            self.pos = 0;
-            let max = {
-                let mut st = self.state.borrow_mut();
-                // The number of the line about to be read, for its errors.
-                st.line += 1;
-                st.options.limits.line_bytes
-            };
-            let result = match self.next_line(max) {
-                Ok(false) => {
-                    self.state.borrow_mut().line -= 1;
-                    return Ok(&[]);
-                }
-                Ok(true) => check_line(&self.raw, &mut self.state.borrow_mut(), &mut self.out),
-                Err(e) => Err(e),
-            };
-            if let Err(e) = result {
-                let mut st = self.state.borrow_mut();
-                let e = e.context(format!("{} line {}", st.display, st.line.max(1)));
-                st.error = Some(e);
-                return Err(std::io::Error::other("stopped by isr's check"));
-            }
+        if std::mem::take(&mut self.first) && self.raw.starts_with(b"\xEF\xBB\xBF") {
+            self.raw.drain(..3);
         }
-        Ok(&self.out[self.pos..])
-    }
-
-    fn consume(&mut self, amt: usize) {
-        self.pos = (self.pos + amt).min(self.out.len());
+        Ok(Some(&self.raw))
     }
 }
 
 /// Statements of the OBJ format isr does not render (free-form geometry,
 /// lines, points, smoothing groups, display attributes): each is ignored,
-/// with one warning per statement.
+/// with one warning for them all.
 const IGNORED: &[(&str, &str)] = &[
     ("l", "line elements are not rendered"),
     ("p", "point elements are not rendered"),
@@ -151,14 +115,11 @@ const IGNORED: &[(&str, &str)] = &[
     ("mg", "merging groups are not read"),
 ];
 
-/// Checks one line (without its end of line) and writes what tobj is to
-/// parse into `out` (always ending in a newline).
-fn check_line(raw: &[u8], st: &mut State, out: &mut Vec<u8>) -> Result<()> {
-    use std::io::Write as _;
+/// Checks one line (without its end of line) and adds what it defines.
+pub(super) fn line(raw: &[u8], st: &mut State) -> Result<()> {
     let trimmed = raw.trim_ascii_start();
     if trimmed.is_empty() || trimmed[0] == b'#' {
-        // Comments may be in any encoding; tobj gets an empty line.
-        out.push(b'\n');
+        // Comments may be in any encoding.
         return Ok(());
     }
     let line = std::str::from_utf8(raw)
@@ -169,13 +130,14 @@ fn check_line(raw: &[u8], st: &mut State, out: &mut Vec<u8>) -> Result<()> {
     let limits = st.options.limits;
     match key {
         "v" => {
-            let n: Vec<f32> = numbers(words, "vertex", st.positions + 1)?;
+            let index = st.geometry.positions.len() + 1;
+            let n: Vec<f32> = numbers(words, "vertex", index)?;
             let (x, y, z) = match n.len() {
                 3 | 6 => (n[0], n[1], n[2]),
                 4 => {
                     let w = n[3];
                     if w == 0.0 {
-                        bail!("vertex {} has the weight w = 0", st.positions + 1);
+                        bail!("vertex {index} has the weight w = 0");
                     }
                     (n[0] / w, n[1] / w, n[2] / w)
                 }
@@ -185,110 +147,89 @@ fn check_line(raw: &[u8], st: &mut State, out: &mut Vec<u8>) -> Result<()> {
                 ),
             };
             if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                bail!(
-                    "vertex {} is at ({x}, {y}, {z}), not a finite position",
-                    st.positions + 1
-                );
+                bail!("vertex {index} is at ({x}, {y}, {z}), not a finite position");
             }
-            st.positions += 1;
-            if st.positions > limits.vertices {
+            if index as u64 > limits.vertices {
                 bail!(
                     "the file has more than {} vertex positions (v); the limit is {}",
                     limits.vertices,
                     limits.vertices
                 );
             }
-            writeln!(out, "v {x} {y} {z}")?;
+            st.geometry.positions.push([x, y, z]);
         }
         "vt" => {
-            let n = numbers(words, "texture coordinate", st.texcoords + 1)?;
+            let index = st.geometry.texcoords.len() + 1;
+            let n = numbers(words, "texture coordinate", index)?;
             if !(1..=3).contains(&n.len()) {
                 bail!(
                     "a texture coordinate is `vt u [v [w]]`; this one has {} numbers",
                     n.len()
                 );
             }
-            st.texcoords += 1;
-            if st.texcoords > limits.vertices {
+            let (u, v) = (n[0], n.get(1).copied().unwrap_or(0.0));
+            if u.abs().max(v.abs()) > limits.texcoord {
+                bail!(
+                    "texture coordinate {index} is ({u:e}, {v:e}); isr supports texture coordinates up to {} (repeats of the texture): beyond, 32-bit floats keep too few bits for a texel",
+                    limits.texcoord
+                );
+            }
+            if index as u64 > limits.vertices {
                 bail!(
                     "the file has more than {} texture coordinates (vt); the limit is {}",
                     limits.vertices,
                     limits.vertices
                 );
             }
-            writeln!(out, "vt {} {}", n[0], n.get(1).copied().unwrap_or(0.0))?;
+            st.geometry.texcoords.push([u, v]);
         }
         "vn" => {
-            let n = numbers(words, "normal", st.normals + 1)?;
+            let index = st.geometry.normals.len() + 1;
+            let n = numbers(words, "normal", index)?;
             if n.len() != 3 {
                 bail!("a normal is `vn x y z`; this one has {} number(s)", n.len());
             }
-            st.normals += 1;
-            if st.normals > limits.vertices {
+            if index as u64 > limits.vertices {
                 bail!(
                     "the file has more than {} normals (vn); the limit is {}",
                     limits.vertices,
                     limits.vertices
                 );
             }
-            writeln!(out, "vn {} {} {}", n[0], n[1], n[2])?;
+            let unit = crate::scene::direction(Vec3::new(n[0], n[1], n[2]));
+            if unit.is_none() {
+                let at = st.here();
+                st.tally.zero_normals.add(|| at);
+            }
+            // A zero normal is kept as zero: faces using it get computed
+            // normals.
+            st.geometry
+                .normals
+                .push(unit.map_or([0.0; 3], |n| n.to_array()));
         }
-        "f" => {
-            out.push(b'f');
-            let mut corners = 0u64;
-            for word in words {
-                corners += 1;
-                let [v, vt, vn] = corner(word, st)?;
-                write!(out, " {}", v.unwrap_or_default())?;
-                match (vt, vn) {
-                    (None, None) => {}
-                    (Some(t), None) => write!(out, "/{t}")?,
-                    (None, Some(n)) => write!(out, "//{n}")?,
-                    (Some(t), Some(n)) => write!(out, "/{t}/{n}")?,
-                }
-            }
-            out.push(b'\n');
-            if corners < 3 {
-                bail!(
-                    "a face needs at least 3 vertices; this one has {corners}{}",
-                    if corners > 0 {
-                        " (is the line cut short?)"
-                    } else {
-                        ""
-                    }
-                );
-            }
-            st.triangles += corners - 2;
-            if st.triangles > limits.triangles {
-                bail!(
-                    "the faces so far fan into {} triangles; the limit is {}",
-                    st.triangles,
-                    limits.triangles
-                );
-            }
-        }
-        "o" | "g" => writeln!(out, "{key} {rest}")?,
+        "f" => face(words, st)?,
+        // Groups and objects do not split meshes (one mesh a material): a
+        // file of a million `g` lines costs nothing more.
+        "o" | "g" => {}
         "usemtl" => {
             if rest.is_empty() {
                 bail!("usemtl names no material");
             }
-            if !st.material_names.contains(rest) {
-                let line = st.line;
-                st.unknown_materials
-                    .entry(rest.to_string())
-                    .or_insert((line, 0))
-                    .1 += 1;
+            let found = st.materials.by_name.get(rest).copied();
+            if found.is_none() {
+                let at = st.here();
+                st.tally.unknown_materials.add(rest, "", || at);
             }
-            writeln!(out, "usemtl {rest}")?;
+            st.select(found);
         }
         "mtllib" => {
             if rest.is_empty() {
                 bail!("mtllib names no file");
             }
-            // Each name on a line of its own: tobj reads the rest of the
-            // line as one name.
+            // Several names on a line, separated by spaces.
             for name in rest.split_whitespace() {
-                writeln!(out, "mtllib {name}")?;
+                super::mtl::load_library(st, name)
+                    .map_err(|e| e.context(format!("mtllib {}", quote(name))))?;
             }
         }
         _ => {
@@ -296,20 +237,66 @@ fn check_line(raw: &[u8], st: &mut State, out: &mut Vec<u8>) -> Result<()> {
                 .iter()
                 .find(|(k, _)| *k == key)
                 .map_or("it is not part of the OBJ format isr reads", |(_, why)| why);
-            let line = st.line;
-            st.ignored
-                .entry(key.to_string())
-                .or_insert((line, 0, why))
-                .1 += 1;
-            out.push(b'\n');
+            let at = st.here();
+            st.tally.ignored_statements.add(key, why, || at);
         }
+    }
+    Ok(())
+}
+
+/// A face: its corners checked one at a time and fanned into triangles
+/// as they come (a face of 10^6 corners holds no list of them).
+fn face<'a>(words: impl Iterator<Item = &'a str>, st: &mut State) -> Result<()> {
+    let mut corners = 0u64;
+    let mut first = [0u32; 3];
+    let mut previous = [0u32; 3];
+    let (mut with_normal, mut with_uv) = (0u64, 0u64);
+    for word in words {
+        let c = corner(word, st)?;
+        corners += 1;
+        with_normal += u64::from(c[2] != super::NONE);
+        with_uv += u64::from(c[1] != super::NONE);
+        match corners {
+            1 => first = c,
+            2 => {}
+            _ => {
+                st.triangles += 1;
+                if st.triangles > st.options.limits.triangles {
+                    bail!(
+                        "the faces so far fan into more than {} triangles; the limit is {}",
+                        st.options.limits.triangles,
+                        st.options.limits.triangles
+                    );
+                }
+                st.triangle([first, previous, c])?;
+            }
+        }
+        previous = c;
+    }
+    if corners < 3 {
+        bail!(
+            "a face needs at least 3 vertices; this one has {corners}{}",
+            if corners > 0 {
+                " (is the line cut short?)"
+            } else {
+                ""
+            }
+        );
+    }
+    if with_normal > 0 && with_normal < corners {
+        let at = st.here();
+        st.tally.partial_normals.add(|| at);
+    }
+    if with_uv > 0 && with_uv < corners {
+        let at = st.here();
+        st.tally.partial_texcoords.add(|| at);
     }
     Ok(())
 }
 
 /// The numbers of a `v`, `vt` or `vn` line; a word that is not one is an
 /// error naming the element.
-fn numbers<'a>(words: impl Iterator<Item = &'a str>, what: &str, index: u64) -> Result<Vec<f32>> {
+fn numbers<'a>(words: impl Iterator<Item = &'a str>, what: &str, index: usize) -> Result<Vec<f32>> {
     let mut n = Vec::with_capacity(4);
     for w in words {
         if n.len() == 7 {
@@ -317,11 +304,11 @@ fn numbers<'a>(words: impl Iterator<Item = &'a str>, what: &str, index: u64) -> 
         }
         let x: f32 = w
             .parse()
-            .map_err(|_| anyhow!("{what} {index}: '{}' is not a number", short(w)))?;
+            .map_err(|_| anyhow!("{what} {index}: '{}' is not a number", quote(w)))?;
         if !x.is_finite() {
             bail!(
                 "{what} {index} has the coordinate '{}', which is {} in 32-bit floats: coordinates must be finite",
-                short(w),
+                quote(w),
                 x
             );
         }
@@ -330,27 +317,29 @@ fn numbers<'a>(words: impl Iterator<Item = &'a str>, what: &str, index: u64) -> 
     Ok(n)
 }
 
-/// The absolute 1-based indices of one face corner (`v`, `v/vt`, `v//vn`
-/// or `v/vt/vn`), each checked against what the file defined above it:
-/// OBJ counts from 1, and `-k` is the k-th last element defined so far.
-fn corner(word: &str, st: &State) -> Result<[Option<u64>; 3]> {
+/// The 0-based indices of one face corner (`v`, `v/vt`, `v//vn` or
+/// `v/vt/vn`; [`super::NONE`] where it names none), each checked against
+/// what the file defined above it: OBJ counts from 1, and `-k` is the k-th
+/// last element defined so far.
+fn corner(word: &str, st: &State) -> Result<[u32; 3]> {
     let mut parts = word.split('/');
-    let mut out = [None; 3];
+    let mut out = [super::NONE; 3];
     let names = ["vertex", "texture coordinate", "normal"];
-    let counts = [st.positions, st.texcoords, st.normals];
+    let g = &st.geometry;
+    let counts = [g.positions.len(), g.texcoords.len(), g.normals.len()].map(|n| n as u64);
     for k in 0..3 {
         let Some(p) = parts.next() else { break };
         if p.is_empty() {
             if k == 0 {
-                bail!("face vertex '{}' has no position index", short(word));
+                bail!("face vertex '{}' has no position index", quote(word));
             }
             continue;
         }
         let i: i64 = p.parse().map_err(|_| {
             anyhow!(
                 "face vertex '{}': '{}' is not an index",
-                short(word),
-                short(p)
+                quote(word),
+                quote(p)
             )
         })?;
         let n = counts[k];
@@ -361,32 +350,27 @@ fn corner(word: &str, st: &State) -> Result<[Option<u64>; 3]> {
         } else if i == 0 {
             bail!(
                 "face vertex '{}' uses {} index 0; OBJ indices count from 1 (or back from -1)",
-                short(word),
+                quote(word),
                 names[k]
             );
         } else {
             bail!(
                 "face vertex '{}' refers to {} {i}, but {n} {} defined above the face",
-                short(word),
+                quote(word),
                 names[k],
                 if n == 1 { "is" } else { "are" }
             );
         };
-        out[k] = Some(abs);
+        out[k] = u32::try_from(abs - 1)
+            .ok()
+            .filter(|&i| i != super::NONE)
+            .ok_or_else(|| anyhow!("{} {i} is past the 32-bit indices isr uses", names[k]))?;
     }
     if parts.next().is_some() {
         bail!(
             "face vertex '{}' has more than three indices (v/vt/vn)",
-            short(word)
+            quote(word)
         );
     }
     Ok(out)
-}
-
-/// `s` cut to 40 characters for messages.
-pub(super) fn short(s: &str) -> String {
-    match s.char_indices().nth(40) {
-        Some((i, _)) => format!("{}...", &s[..i]),
-        None => s.to_string(),
-    }
 }

@@ -3,6 +3,7 @@
 //! opened for reading line by line.
 
 use super::super::uri;
+use crate::scene::text;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 
@@ -25,8 +26,9 @@ pub(in crate::scene) fn resolve(
     if path.is_absolute() {
         if !allow_outside {
             bail!(
-                "{name} is an absolute path: isr reads only files inside the scene file's folder; \
-                 pass --allow-outside-uris to allow this"
+                "{} is an absolute path: isr reads only files inside the scene file's folder; \
+                 pass --allow-outside-uris to allow this",
+                crate::scene::text::quote(&name)
             );
         }
         return Ok(path.to_path_buf());
@@ -67,14 +69,14 @@ pub(in crate::scene) fn open_regular(path: &Path, max: u64) -> Result<(std::fs::
         if !meta.is_file() {
             bail!(
                 "{} is {}: only regular files are read",
-                path.display(),
+                text::path(&path),
                 uri::kind(meta.file_type())
             );
         }
         if meta.len() > max {
             bail!(
                 "{} is {}, more than the limit of {}",
-                path.display(),
+                text::path(&path),
                 super::limits::bytes(meta.len()),
                 super::limits::bytes(max)
             );
@@ -82,13 +84,13 @@ pub(in crate::scene) fn open_regular(path: &Path, max: u64) -> Result<(std::fs::
         Ok(())
     };
     let meta =
-        std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     check(&meta)?;
     let file =
-        std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     let meta = file
         .metadata()
-        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        .map_err(|e| anyhow!("cannot read {}: {e}", text::path(&path)))?;
     check(&meta)?;
     Ok((file, meta.len()))
 }

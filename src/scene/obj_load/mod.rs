@@ -1,23 +1,27 @@
-//! Wavefront OBJ + MTL (`.obj`) to [`Scene`]: polygons fanned into
-//! triangles by tobj, `Kd` times `map_Kd` (PNG or JPEG, sRGB) as the
-//! Lambertian albedo, normals computed where the file has none (with a
-//! crease angle, `normals`), degenerate faces skipped and counted.
+//! Wavefront OBJ + MTL (`.obj`) to [`Scene`], read by isr line by line:
+//! polygons fanned into triangles, one mesh per material, `Kd` times
+//! `map_Kd` (PNG or JPEG, sRGB) as the Lambertian albedo, normals computed
+//! where the file has none (with a crease angle, `normals`), degenerate
+//! faces skipped and counted.
 //!
 //! The same policy as the glTF loader (docs/security.md): the OBJ's
 //! libraries and textures only from inside its folder unless
 //! `LoadOptions::allow_outside_uris`, regular files only, every size and
-//! count budget of [`Limits`] checked before the work it bounds. The file is
-//! checked to be within `scene_file_bytes` before it is opened, then read
-//! one line at a time by [`check::Checked`], which counts vertices and
-//! triangles against the budgets as lines arrive, so a file of 10^8 `v`
-//! lines is refused after `vertices` of them without being read whole.
-//! Errors name the file and the line. An OBJ has no lights or camera: the
-//! scene gets the default ones (`gltf_load::fitted_light`, `fitted_camera`)
-//! with a warning, or those of a scene description (`scene::description`)
-//! or the command line (`--light`, `--camera`).
+//! count budget of [`Limits`] checked at the line that passes it, before
+//! the work it bounds. The file is checked to be within `scene_file_bytes`
+//! before it is opened, then read one line at a time (`check`), each line
+//! adding to the geometry and to the mesh of its material (`assemble`), so
+//! memory grows with what the file defines, never with how often it names
+//! a library, a group or a material. Errors name the file and the line; a
+//! warning is said once per kind, with a count (`tally`). An OBJ has no
+//! lights or camera: the scene gets the default ones
+//! (`gltf_load::fitted_light`, `fitted_camera`) with a warning, or those of
+//! a scene description (`scene::description`) or the command line
+//! (`--light`, `--camera`).
 //!
 //! Choices: every OBJ material is double-sided (the format has no culling
-//! and archive models are not consistently wound); texture coordinates are
+//! and archive models are not consistently wound); a face wound against
+//! its normals is turned to agree with them; texture coordinates are
 //! flipped to the top-left origin the GPU samples; a texture that is
 //! missing or fails to decode is an error, as in a glTF, not the
 //! material's `Kd` with a warning: a different albedo changes every
@@ -25,22 +29,27 @@
 
 use super::gltf_load::{fitted_camera, fitted_light, LoadOptions};
 pub use super::limits::Limits;
-use super::{limits, GpuVertex, Instance, Material, Mesh, Scene};
-use anyhow::{anyhow, bail, Context as _, Result};
+use super::text::quote_at_most;
+use super::{limits, Instance, Material, Mesh, Scene};
+use anyhow::{anyhow, bail, Result};
 use glam::{Vec3, Vec4};
-use std::cell::RefCell;
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::HashMap;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
+mod assemble;
 mod check;
 pub(super) mod files;
 mod mtl;
 pub mod normals;
+mod tally;
 
 /// Albedo of faces without a material (no `usemtl`, or a name no library
 /// defines), and of a material without `Kd` or `map_Kd`.
 pub const DEFAULT_ALBEDO: f32 = 0.8;
+
+/// An index a face corner does not give (no texture coordinate, no normal).
+const NONE: u32 = u32::MAX;
 
 /// Loads an OBJ file with the default (safe) options.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -63,7 +72,7 @@ pub(in crate::scene) fn load_mesh(
     albedo: Vec3,
 ) -> Result<Scene> {
     let (file, _) = files::open_regular(path, options.limits.scene_file_bytes)
-        .map_err(|e| anyhow!("cannot read scene file {}: {e:#}", path.display()))?;
+        .map_err(|e| anyhow!("cannot read scene file {}: {e:#}", display(path)))?;
     let reader = std::io::BufReader::with_capacity(1 << 16, file);
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
@@ -72,14 +81,18 @@ pub(in crate::scene) fn load_mesh(
     }));
     std::panic::set_hook(previous);
     match result {
-        Ok(r) => r
-            .map(|(s, _)| s)
-            .with_context(|| format!("loading scene {}", path.display())),
+        // Every error names the file once, with its line where it has one.
+        Ok(r) => r.map(|(s, _)| s),
         Err(_) => bail!(
-            "loading scene {}: the file is malformed in a way the OBJ reader could not handle",
-            path.display()
+            "{}: the file is malformed in a way the OBJ reader could not handle",
+            display(path)
         ),
     }
+}
+
+/// The file's name as messages show it.
+fn display(path: &Path) -> String {
+    quote_at_most(&path.display().to_string(), super::text::PATH_CHARS)
 }
 
 /// Loads an OBJ from `bytes` as if read from `path` (whose folder holds its
@@ -133,72 +146,82 @@ fn load_checked(
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-    let state = RefCell::new(State {
-        display: path.display().to_string(),
+    let mut st = State {
+        display: display(path),
+        name: path.file_name().map_or_else(
+            || display(path),
+            |n| super::text::quote(&n.to_string_lossy()),
+        ),
         base,
         options: options.clone(),
-        ..Default::default()
-    });
-    let mut checked = check::Checked::new(reader, &state);
-    let tobj_options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
+        line: 0,
+        geometry: Default::default(),
+        triangles: 0,
+        distinct: 0,
+        meshes: Vec::new(),
+        mesh_of: HashMap::new(),
+        current: None,
+        current_mesh: None,
+        materials: Default::default(),
+        tally: Default::default(),
     };
-    let parsed = tobj::load_obj_buf(&mut checked, &tobj_options, |name| {
-        mtl::load_library(&state, name)
-    });
-    let bytes_read = checked.bytes;
-    drop(checked);
-    let mut st = state.into_inner();
-    if let Some(e) = st.error.take() {
-        return Err(e);
+    let mut lines = check::Lines::new(reader);
+    let max = options.limits.line_bytes;
+    loop {
+        st.line += 1;
+        let raw = match lines.next(max) {
+            Ok(Some(raw)) => raw,
+            Ok(None) => break,
+            Err(e) => return Err(e.context(st.at())),
+        };
+        check::line(raw, &mut st).map_err(|e| e.context(st.at()))?;
     }
-    let (models, _) = parsed.map_err(|e| {
-        anyhow!(
-            "{} line {}: the OBJ reader (tobj) reports: {e}",
-            st.display,
-            st.line
-        )
-    })?;
-    build(path, models, st, albedo).map(|s| (s, bytes_read))
+    st.line -= 1;
+    let bytes = lines.bytes;
+    drop(lines);
+    build(path, st, albedo).map(|s| (s, bytes))
 }
 
-/// What the line check and the library reader share while tobj parses.
-#[derive(Default)]
+/// What the lines read so far defined.
 struct State {
-    /// The OBJ file, for messages.
+    /// The OBJ file, for messages; and its name alone, for warnings.
     display: String,
+    name: String,
     /// The scene's folder: libraries and textures are confined to it.
     base: PathBuf,
     options: LoadOptions,
-    /// Lines read so far.
+    /// The line being read.
     line: u64,
-    positions: u64,
-    texcoords: u64,
-    normals: u64,
+    geometry: assemble::Geometry,
+    /// Triangles the faces fan into, degenerate ones too.
     triangles: u64,
-    /// The first error: the reader stops tobj when it is set.
-    error: Option<anyhow::Error>,
-    /// Statements ignored: key -> (first line, count, why).
-    ignored: BTreeMap<String, (u64, u64, &'static str)>,
-    /// MTL keys ignored: key -> (first "file line N", count, why).
-    ignored_mtl: BTreeMap<String, (String, u64, &'static str)>,
-    /// Material names the libraries read so far define.
-    material_names: HashSet<String>,
-    /// `usemtl` names no library defined: name -> (first line, count).
-    unknown_materials: BTreeMap<String, (u64, u64)>,
-    /// Every library's materials in tobj's order (its material ids).
-    materials: Vec<mtl::MtlMaterial>,
-    /// Libraries read, by resolved path.
-    libraries: HashMap<PathBuf, mtl::Library>,
-    library_bytes: u64,
-    warnings: Vec<String>,
+    /// Distinct vertices of all meshes.
+    distinct: u64,
+    /// One mesh per material, in the order first used.
+    meshes: Vec<assemble::MeshBuilder>,
+    mesh_of: HashMap<Option<u32>, usize>,
+    /// The material of the faces that follow (`usemtl`), and its mesh.
+    current: Option<u32>,
+    current_mesh: Option<usize>,
+    materials: mtl::Materials,
+    tally: tally::Tally,
 }
 
-/// The scene from tobj's models.
-fn build(path: &Path, models: Vec<tobj::Model>, mut st: State, albedo: Vec3) -> Result<Scene> {
+impl State {
+    /// "scene.obj line N", for messages.
+    fn at(&self) -> String {
+        format!("{} line {}", self.display, self.line.max(1))
+    }
+
+    /// "scene.obj line N" with the file's name alone, for warnings, which
+    /// list several places and are said after the file is named.
+    fn here(&self) -> String {
+        format!("{} line {}", self.name, self.line.max(1))
+    }
+}
+
+/// The scene from the meshes read.
+fn build(path: &Path, mut st: State, albedo: Vec3) -> Result<Scene> {
     let limits = st.options.limits;
     let name = path
         .file_stem()
@@ -209,87 +232,21 @@ fn build(path: &Path, models: Vec<tobj::Model>, mut st: State, albedo: Vec3) -> 
         fitted_light(Vec3::splat(-1.0), Vec3::ONE),
         fitted_camera(Vec3::splat(-1.0), Vec3::ONE),
     );
-    let mut warnings = std::mem::take(&mut st.warnings);
-    let mut material_ids: HashMap<Option<usize>, usize> = HashMap::new();
     let mut textures = mtl::Textures::default();
-    let (mut degenerate, mut vertices_total) = (0u64, 0u64);
-    let (mut computed, mut dropped_uv, mut dropped_normals) = (0usize, Vec::new(), Vec::new());
-    for model in models {
-        let m = model.mesh;
-        let n = m.positions.len() / 3;
-        if m.indices.is_empty() {
-            continue;
-        }
-        vertices_total += n as u64;
-        if vertices_total > limits.vertices {
-            bail!(
-                "the faces make more than {} distinct vertices (position, texture coordinate, normal); the limit is {}",
-                limits.vertices,
-                limits.vertices
-            );
-        }
-        // tobj gives a vertex a texture coordinate or normal only where the
-        // face names one: unless every vertex of the object has one, they do
-        // not line up with the positions.
-        let uv_ok = m.texcoords.len() == 2 * n;
-        let normals_ok = m.normals.len() == 3 * n;
-        if !m.texcoords.is_empty() && !uv_ok {
-            dropped_uv.push(model.name.clone());
-        }
-        if !m.normals.is_empty() && !normals_ok {
-            dropped_normals.push(model.name.clone());
-        }
-        let vertices: Vec<GpuVertex> = (0..n)
-            .map(|i| GpuVertex {
-                position: [
-                    m.positions[3 * i],
-                    m.positions[3 * i + 1],
-                    m.positions[3 * i + 2],
-                ],
-                normal: if normals_ok {
-                    Vec3::from_slice(&m.normals[3 * i..3 * i + 3])
-                        .normalize_or(Vec3::Y)
-                        .to_array()
-                } else {
-                    [0.0; 3]
-                },
-                // OBJ's v grows upward; the GPU's rows start at the top.
-                uv: if uv_ok {
-                    [m.texcoords[2 * i], 1.0 - m.texcoords[2 * i + 1]]
-                } else {
-                    [0.0; 2]
-                },
-            })
-            .collect();
-        let mut indices = Vec::with_capacity(m.indices.len());
-        for t in m.indices.chunks_exact(3) {
-            let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
-            let area2 = (p(1) - p(0)).cross(p(2) - p(0));
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || area2 == Vec3::ZERO {
-                degenerate += 1;
-                continue;
-            }
-            indices.extend_from_slice(t);
-        }
+    let mut made = 0u64;
+    for mesh in std::mem::take(&mut st.meshes) {
+        let id = mesh.material;
+        let left = limits.vertices.saturating_sub(made);
+        let (vertices, indices) = assemble::finish(mesh, &st.geometry, left)
+            .map_err(|e| e.context(st.display.clone()))?;
+        made += vertices.len() as u64;
         if indices.is_empty() {
             continue;
         }
-        let (vertices, indices) = if normals_ok {
-            (vertices, indices)
-        } else {
-            computed += indices.len() / 3;
-            normals::crease_normals(&vertices, &indices)
-        };
-        let material = match material_ids.get(&m.material_id) {
-            Some(&id) => id,
-            None => {
-                let id = material(&mut scene, m.material_id, &st, &mut textures, albedo)?;
-                material_ids.insert(m.material_id, id);
-                id
-            }
-        };
+        let material = material(&mut scene, id, &st, &mut textures, albedo)
+            .map_err(|e| e.context(st.display.clone()))?;
         scene.meshes.push(Mesh {
-            name: model.name,
+            name: scene.materials[material].name.clone(),
             vertices,
             indices,
             material,
@@ -300,6 +257,7 @@ fn build(path: &Path, models: Vec<tobj::Model>, mut st: State, albedo: Vec3) -> 
         });
     }
     if scene.instances.is_empty() {
+        let degenerate = st.tally.degenerate;
         bail!(
             "{} has no faces to render{}",
             st.display,
@@ -310,78 +268,76 @@ fn build(path: &Path, models: Vec<tobj::Model>, mut st: State, albedo: Vec3) -> 
             }
         );
     }
-    let (lo, hi) = limits.check_extent(
-        &scene,
-        "scale the scene down, e.g. with \"scale\" in a scene description",
-    )?;
-    if degenerate > 0 {
-        warnings.push(format!(
-            "{degenerate} degenerate face(s) (zero area, or a vertex used twice) skipped"
-        ));
-    }
-    if computed > 0 {
-        warnings.push(format!(
-            "normals computed for {computed} triangle(s) without them (crease angle {} degrees)",
-            normals::CREASE_DEGREES
-        ));
-    }
-    for (what, names) in [
-        ("texture coordinates", dropped_uv),
-        ("normals", dropped_normals),
-    ] {
-        if !names.is_empty() {
-            warnings.push(format!(
-                "{what} dropped for object(s) {}: some of their face vertices have none",
-                names.join(", ")
-            ));
-        }
-    }
-    for (key, (line, count, why)) in &st.ignored {
-        warnings.push(format!(
-            "OBJ statement '{}' ignored ({why}): line {line}{}",
-            check::short(key),
-            more(*count)
-        ));
-    }
-    for (key, (at, count, why)) in &st.ignored_mtl {
-        warnings.push(format!(
-            "MTL key '{}' ignored ({why}): {at}{}",
-            check::short(key),
-            more(*count)
-        ));
-    }
-    for (name, (line, count)) in &st.unknown_materials {
-        warnings.push(format!(
-            "usemtl {} (line {line}{}) names no material of the material libraries: albedo {albedo}",
-            check::short(name),
-            more(*count)
-        ));
-    }
-    let light = fitted_light(lo, hi);
-    scene.lights = vec![light];
+    let (lo, hi) = limits
+        .check_extent(
+            &scene,
+            "scale the scene down, e.g. with \"scale\" in a scene description",
+        )
+        .map_err(|e| e.context(st.display.clone()))?;
+    scene.warnings = warnings(&st, albedo);
+    scene.lights = vec![fitted_light(lo, hi)];
     scene.camera = fitted_camera(lo, hi);
-    scene.warnings = warnings;
     Ok(scene)
 }
 
-/// ", and N more" for a count of N + 1 lines.
-fn more(count: u64) -> String {
-    if count > 1 {
-        format!(" and {} more", count - 1)
-    } else {
-        String::new()
+/// One warning per kind, with its count and where it first happened.
+fn warnings(st: &State, albedo: Vec3) -> Vec<String> {
+    let t = &st.tally;
+    let mut w = Vec::new();
+    if t.degenerate > 0 {
+        w.push(format!(
+            "{} degenerate triangle(s) (zero area, or a vertex used twice) skipped",
+            t.degenerate
+        ));
     }
+    if t.computed > 0 {
+        w.push(format!(
+            "normals computed for {} triangle(s) without them (crease angle {} degrees)",
+            t.computed,
+            normals::CREASE_DEGREES
+        ));
+    }
+    let counted = [
+        (&t.zero_normals, "normal(s) of zero length (vn 0 0 0) ignored: the faces using them get computed normals"),
+        (&t.partial_normals, "face(s) name a normal at some corners only: their normals are computed"),
+        (&t.rewound, "triangle(s) wound against their normals (vn) turned to agree with them, so that they shade by the file's normals from either side"),
+        (&t.partial_texcoords, "face(s) name texture coordinates at some corners only: (0, 0) at the others"),
+        (&t.duplicate_materials, "material(s) defined twice in one library: the last definition is used"),
+        (&t.kd_above_one, "Kd value(s) above 1 (reflecting more light than they receive) clamped to 1"),
+        (&t.map_options, "map_Kd option(s) ignored (the texture is read as it is)"),
+    ];
+    for (count, what) in counted {
+        if count.count > 0 {
+            w.push(format!("{} {what}: first at {}", count.count, count.first));
+        }
+    }
+    if !t.ignored_statements.is_empty() {
+        w.push(format!(
+            "OBJ statements ignored{}",
+            t.ignored_statements.said()
+        ));
+    }
+    if !t.ignored_keys.is_empty() {
+        w.push(format!("MTL keys ignored{}", t.ignored_keys.said()));
+    }
+    if !t.unknown_materials.is_empty() {
+        w.push(format!(
+            "usemtl names no material of the material libraries (albedo {albedo} there){}",
+            t.unknown_materials.said()
+        ));
+    }
+    w
 }
 
-/// The scene material for tobj's material id (`None`: the default).
+/// The scene material for material `id` of the libraries (`None`: the default).
 fn material(
     scene: &mut Scene,
-    id: Option<usize>,
+    id: Option<u32>,
     st: &State,
     textures: &mut mtl::Textures,
     default: Vec3,
 ) -> Result<usize> {
-    let (name, albedo, texture) = match id.and_then(|i| st.materials.get(i)) {
+    let (name, albedo, texture) = match id.and_then(|i| st.materials.list.get(i as usize)) {
         None => ("default".to_string(), default, None),
         Some(m) => {
             let texture = mtl::texture(m, st, textures, scene)?;
@@ -391,7 +347,7 @@ fn material(
             } else {
                 DEFAULT_ALBEDO
             }));
-            (m.name.clone(), kd, texture)
+            (super::text::quote(&m.name), kd, texture)
         }
     };
     scene.materials.push(Material {

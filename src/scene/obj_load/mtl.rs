@@ -1,36 +1,54 @@
 //! MTL material libraries, read by isr (`newmtl`, `Kd`, `map_Kd`; every
-//! other key is ignored with one warning per key) and handed to tobj for its
-//! `usemtl` lookup; and the `map_Kd` textures (PNG or JPEG, sRGB), read
-//! under the same policy and budgets as a glTF's images.
+//! other key is ignored, with one warning for them all), each library once
+//! however often the OBJ names it; and the `map_Kd` textures (PNG or JPEG,
+//! sRGB), read under the same policy and budgets as a glTF's images.
+//!
+//! Memory: a library is read whole (within `material_library_bytes` for
+//! all of them together), then each material keeps its name, `Kd` and
+//! `map_Kd` (a few words beside the bytes of the names), and there are at
+//! most `Limits::materials` of them.
 
-use super::check::short;
 use super::{files, State};
+use crate::scene::text::{quote, strip_bom};
 use crate::scene::{limits, Texture};
 use anyhow::{anyhow, bail, Context as _, Result};
 use glam::Vec3;
-use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// A material as its library wrote it.
-#[derive(Clone, Debug)]
 pub(super) struct MtlMaterial {
-    pub name: String,
+    pub name: Box<str>,
     /// `Kd`, clamped to [0, 1]; `None` when the library gives none.
     pub kd: Option<Vec3>,
     /// `map_Kd`: the file name as written (options removed) and its line.
-    pub map_kd: Option<(String, u64)>,
-    /// The library, as the OBJ named it (for messages), and the folder its
-    /// texture names are relative to (relative to the scene's folder where
-    /// the library is inside it).
-    pub library: String,
+    pub map_kd: Option<(Box<str>, u64)>,
+    /// Its library, an index into [`Materials::libraries`].
+    pub library: u32,
+}
+
+/// A library read: how the OBJ named it (for messages) and the folder its
+/// texture names are relative to (relative to the scene's folder where the
+/// library is inside it).
+pub(super) struct Library {
+    pub name: String,
     pub folder: PathBuf,
 }
 
-/// One library, read once however often it is named.
-#[derive(Clone)]
-pub(super) struct Library {
-    pub materials: Vec<MtlMaterial>,
+/// Every material of every library the OBJ named, in the order defined.
+#[derive(Default)]
+pub(super) struct Materials {
+    pub list: Vec<MtlMaterial>,
+    /// For `usemtl`: the latest definition of each name.
+    pub by_name: HashMap<Box<str>, u32>,
+    pub libraries: Vec<Library>,
+    /// Libraries read, by resolved path: a library named again adds nothing.
+    read: HashSet<PathBuf>,
+    /// Names `mtllib` gave already (a line naming one library 20,000 times
+    /// resolves it once).
+    named: HashSet<String>,
+    /// Bytes of the libraries read, against `material_library_bytes`.
+    bytes: u64,
 }
 
 /// `map_Kd` options and how many values each takes (the MTL specification's
@@ -50,80 +68,78 @@ const MAP_OPTIONS: &[(&str, usize)] = &[
     ("-bm", 1),
 ];
 
-/// tobj's material loader: reads library `name` (relative to the OBJ's
-/// folder) and returns its materials for `usemtl`; a failure is recorded in
-/// the state (the reader then stops tobj) with the OBJ's line that named it.
-pub(super) fn load_library(state: &RefCell<State>, name: &Path) -> tobj::MTLLoadResult {
-    let mut st = state.borrow_mut();
-    if st.error.is_some() {
-        return Err(tobj::LoadError::GenericFailure);
+/// Reads library `name` (relative to the OBJ's folder) unless it was read
+/// already, adding its materials for the `usemtl` lines that follow.
+pub(super) fn load_library(st: &mut State, name: &str) -> Result<()> {
+    if st.materials.named.contains(name) {
+        return Ok(());
     }
-    let name = name.to_string_lossy().into_owned();
-    match read_library(&mut st, &name) {
-        Ok(lib) => {
-            let mut map = HashMap::new();
-            let mut materials = Vec::new();
-            for (i, m) in lib.materials.iter().enumerate() {
-                map.insert(m.name.clone(), i);
-                st.material_names.insert(m.name.clone());
-                materials.push(tobj::Material {
-                    name: m.name.clone(),
-                    ..Default::default()
-                });
-            }
-            // tobj appends each library's materials to its list: the same
-            // order here, so its material ids index `st.materials`.
-            st.materials.extend(lib.materials);
-            Ok((materials, map))
-        }
-        Err(e) => {
-            let e = e.context(format!(
-                "{} line {}: mtllib {}",
-                st.display,
-                st.line,
-                short(&name)
-            ));
-            st.error = Some(e);
-            Err(tobj::LoadError::GenericFailure)
-        }
-    }
-}
-
-fn read_library(st: &mut State, name: &str) -> Result<Library> {
     let allow = st.options.allow_outside_uris;
     let path = files::resolve(name, Path::new(""), &st.base, allow)?;
-    if let Some(lib) = st.libraries.get(&path) {
-        return Ok(lib.clone());
+    st.materials.named.insert(name.to_string());
+    if !st.materials.read.insert(path.clone()) {
+        return Ok(());
     }
-    let left = st
-        .options
-        .limits
-        .material_library_bytes
-        .saturating_sub(st.library_bytes);
+    let limit = st.options.limits.material_library_bytes;
+    let left = limit.saturating_sub(st.materials.bytes);
     let bytes =
         crate::scene::uri::read_capped(&path, left, "the material library").with_context(|| {
-            if st.library_bytes > 0 {
+            if st.materials.bytes > 0 {
                 format!(
                     "the material libraries may be {} in all, and {} are read already",
-                    limits::bytes(st.options.limits.material_library_bytes),
-                    limits::bytes(st.library_bytes)
+                    limits::bytes(limit),
+                    limits::bytes(st.materials.bytes)
                 )
             } else {
                 format!("reading {}", path.display())
             }
         })?;
-    st.library_bytes += bytes.len() as u64;
-    let folder = files::folder_of(name, Path::new(""));
-    let lib = parse(&bytes, name, folder, st)?;
-    st.libraries.insert(path, lib.clone());
-    Ok(lib)
+    st.materials.bytes += bytes.len() as u64;
+    let library = st.materials.libraries.len() as u32;
+    st.materials.libraries.push(Library {
+        name: quote(name),
+        folder: files::folder_of(name, Path::new("")),
+    });
+    parse(&bytes, library, st)
 }
 
-/// The materials of one library; `name` is how the OBJ named it.
-fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Library> {
-    let mut materials: Vec<MtlMaterial> = Vec::new();
+/// The lines of `bytes`, ended by LF, CRLF or a lone CR.
+fn lines(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
+    let mut rest = bytes;
+    let mut done = bytes.is_empty();
+    std::iter::from_fn(move || {
+        if done {
+            return None;
+        }
+        match rest.iter().position(|&b| b == b'\n' || b == b'\r') {
+            Some(i) => {
+                let line = &rest[..i];
+                let skip = if rest[i] == b'\r' && rest.get(i + 1) == Some(&b'\n') {
+                    2
+                } else {
+                    1
+                };
+                rest = &rest[i + skip..];
+                done = rest.is_empty();
+                Some(line)
+            }
+            None => {
+                done = true;
+                Some(rest)
+            }
+        }
+    })
+}
+
+/// The materials of library number `library`.
+fn parse(bytes: &[u8], library: u32, st: &mut State) -> Result<()> {
     let max_line = st.options.limits.line_bytes;
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+    let max_materials = st.options.limits.materials;
+    let name = st.materials.libraries[library as usize].name.clone();
+    // Names defined by this library so far, for the duplicate warning.
+    let mut defined: HashSet<Box<str>> = HashSet::new();
+    let mut current: Option<u32> = None;
+    for (i, raw) in lines(strip_bom(bytes)).enumerate() {
         let n = i as u64 + 1;
         let at = || format!("{name} line {n}");
         if raw.len() as u64 > max_line {
@@ -133,37 +149,56 @@ fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Li
                 limits::bytes(max_line)
             );
         }
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         let trimmed = raw.trim_ascii_start();
         if trimmed.is_empty() || trimmed[0] == b'#' {
             continue;
         }
-        let line = std::str::from_utf8(raw).map_err(|_| anyhow!("{}: not UTF-8 text", at()))?;
+        let line = std::str::from_utf8(raw).map_err(|e| {
+            anyhow!(
+                "{}: the line is not UTF-8 text (byte {})",
+                at(),
+                e.valid_up_to() + 1
+            )
+        })?;
         let mut words = line.split_whitespace();
         let key = words.next().unwrap_or_default();
         let rest = line.trim_start()[key.len()..].trim();
-        let current = |materials: &mut Vec<MtlMaterial>| -> Result<usize> {
-            if materials.is_empty() {
-                bail!("{}: {key} comes before any newmtl", at());
-            }
-            Ok(materials.len() - 1)
+        let current_material = |current: Option<u32>| -> Result<usize> {
+            current
+                .map(|m| m as usize)
+                .ok_or_else(|| anyhow!("{}: {} comes before any newmtl", at(), quote(key)))
         };
+        let materials = &mut st.materials;
         match key {
             "newmtl" => {
                 if rest.is_empty() {
                     bail!("{}: newmtl names no material", at());
                 }
-                materials.push(MtlMaterial {
-                    name: rest.to_string(),
+                if materials.list.len() as u64 >= max_materials {
+                    bail!(
+                        "{}: the material libraries define more than {max_materials} materials; the limit is {max_materials}",
+                        at()
+                    );
+                }
+                let id = materials.list.len() as u32;
+                let rest: Box<str> = rest.into();
+                if !defined.insert(rest.clone()) {
+                    st.tally
+                        .duplicate_materials
+                        .add(|| format!("{}: newmtl {}", at(), quote(&rest)));
+                }
+                materials.by_name.insert(rest.clone(), id);
+                materials.list.push(MtlMaterial {
+                    name: rest,
                     kd: None,
                     map_kd: None,
-                    library: name.to_string(),
-                    folder: folder.clone(),
+                    library,
                 });
+                current = Some(id);
             }
             "Kd" => {
-                let m = current(&mut materials)?;
-                let values: Vec<&str> = words.collect();
+                let m = current_material(current)?;
+                let values: Vec<&str> = words.take(4).collect();
                 if values.first() == Some(&"spectral") || values.first() == Some(&"xyz") {
                     bail!(
                         "{}: Kd {} is not supported; give the albedo as `Kd r g b`",
@@ -179,7 +214,7 @@ fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Li
                         anyhow!(
                             "{}: Kd takes numbers (`Kd r g b`), got '{}'",
                             at(),
-                            short(rest)
+                            quote(rest)
                         )
                     })?;
                 let kd = match parsed[..] {
@@ -188,7 +223,7 @@ fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Li
                     _ => bail!(
                         "{}: Kd takes three numbers (`Kd r g b`, or one for grey); this one has {}{}",
                         at(),
-                        parsed.len(),
+                        if parsed.len() > 3 { "more".to_string() } else { parsed.len().to_string() },
                         if parsed.len() < 3 { " (is the line cut short?)" } else { "" }
                     ),
                 };
@@ -196,24 +231,23 @@ fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Li
                     bail!("{}: Kd {kd} must be finite and non-negative", at());
                 }
                 if kd.max_element() > 1.0 {
-                    st.warnings.push(format!(
-                        "{}: Kd {kd} of material {} is above 1 (it would reflect more light than it receives); clamped to 1",
-                        at(),
-                        materials[m].name
-                    ));
+                    let material = &materials.list[m].name;
+                    st.tally
+                        .kd_above_one
+                        .add(|| format!("{}: Kd {kd} of material {}", at(), quote(material)));
                 }
-                materials[m].kd = Some(kd.min(Vec3::ONE));
+                materials.list[m].kd = Some(kd.min(Vec3::ONE));
             }
             "map_Kd" => {
-                let m = current(&mut materials)?;
+                let m = current_material(current)?;
                 let words: Vec<&str> = rest.split_whitespace().collect();
                 let mut k = 0;
-                let mut options = Vec::new();
-                while let Some(&(option, count)) = words
+                let mut options = false;
+                while let Some(&(_, count)) = words
                     .get(k)
                     .and_then(|w| MAP_OPTIONS.iter().find(|(o, _)| o == w))
                 {
-                    options.push(option);
+                    options = true;
                     k += 1;
                     // -o, -s and -t take one to three numbers, -mm two;
                     // the others one word. The file name is what is left.
@@ -226,47 +260,35 @@ fn parse(bytes: &[u8], name: &str, folder: PathBuf, st: &mut State) -> Result<Li
                         taken += 1;
                     }
                 }
-                let words = &words[k..];
-                if words.is_empty() {
+                let file = &words[k..];
+                if file.is_empty() {
                     bail!("{}: map_Kd names no texture file", at());
                 }
-                if !options.is_empty() {
-                    st.warnings.push(format!(
-                        "{}: map_Kd options {} ignored (the texture is read as is)",
-                        at(),
-                        options.join(" ")
-                    ));
+                if options {
+                    let options = words[..k].join(" ");
+                    st.tally
+                        .map_options
+                        .add(|| format!("{}: map_Kd {}", at(), quote(&options)));
                 }
-                materials[m].map_kd = Some((words.join(" "), n));
+                materials.list[m].map_kd = Some((file.join(" ").into(), n));
             }
             "mtllib" => {
-                let e = st.ignored_mtl.entry("mtllib".into()).or_insert((
-                    at(),
-                    0,
+                st.tally.ignored_keys.add(
+                    "mtllib",
                     "a material library includes no other files",
-                ));
-                e.1 += 1;
+                    at,
+                );
             }
             _ => {
-                let e = st.ignored_mtl.entry(key.to_string()).or_insert((
-                    at(),
-                    0,
+                st.tally.ignored_keys.add(
+                    key,
                     "isr renders a diffuse albedo only, Kd times map_Kd",
-                ));
-                e.1 += 1;
+                    at,
+                );
             }
         }
     }
-    let mut seen = std::collections::HashSet::new();
-    for m in &materials {
-        if !seen.insert(&m.name) {
-            st.warnings.push(format!(
-                "{name}: material {} is defined more than once; the last definition is used",
-                m.name
-            ));
-        }
-    }
-    Ok(Library { materials })
+    Ok(())
 }
 
 /// Decoded textures, each file once, with the pixel budget counted from the
@@ -289,9 +311,15 @@ pub(super) fn texture(
     let Some((file, line)) = &m.map_kd else {
         return Ok(None);
     };
-    let at = || format!("{} line {line}: map_Kd {}", m.library, short(file));
-    let path = files::resolve(file, &m.folder, &st.base, st.options.allow_outside_uris)
-        .with_context(at)?;
+    let library = &st.materials.libraries[m.library as usize];
+    let at = || format!("{} line {line}: map_Kd {}", library.name, quote(file));
+    let path = files::resolve(
+        file,
+        &library.folder,
+        &st.base,
+        st.options.allow_outside_uris,
+    )
+    .with_context(at)?;
     if let Some(&t) = textures.ids.get(&path) {
         return Ok(Some(t));
     }
@@ -303,9 +331,17 @@ pub(super) fn texture(
 
 fn decode(path: &Path, limits: &limits::Limits, textures: &mut Textures) -> Result<Texture> {
     let bytes = crate::scene::uri::read_capped(path, limits.image_file_bytes, "the image file")?;
-    let label = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
+    let name = path.file_name().map_or_else(
+        || crate::scene::text::path(path),
+        |n| quote(&n.to_string_lossy()),
     );
-    crate::scene::texture_decode::decode_texture(&bytes, label, limits, &mut textures.pixels)
+    // The message's context names the file already ("map_Kd t.png").
+    let mut t = crate::scene::texture_decode::decode_texture(
+        &bytes,
+        "the texture".into(),
+        limits,
+        &mut textures.pixels,
+    )?;
+    t.name = name;
+    Ok(t)
 }

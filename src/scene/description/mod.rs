@@ -57,14 +57,17 @@
 //!   through `center` (default the scene's centre) `turns` times (default
 //!   1), still aimed at the target.
 
-use super::animation::{
-    rotation_looking_along, Animation, Channel, Interpolation, Local, Parent, Property, Trs,
-};
+use super::animation::{Animation, Parent};
 use super::gltf_load::{fitted_camera, fitted_light, LoadOptions};
 use super::obj_load::files;
-use super::{Camera, FileKind, Light, LightKind, Scene};
+use super::{FileKind, Scene};
 use anyhow::{anyhow, bail, Context as _, Result};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
+use lights::{add_path, camera, light};
+pub use options::{parse_camera, parse_light};
+
+mod lights;
+mod options;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -120,16 +123,19 @@ struct Room {
     albedo: Option<serde_json::Value>,
 }
 
-/// A light as a description or `--light` gives it.
+/// A light as a description or `--light` gives it. Places (position,
+/// target, an orbit's centre) are world metres in f64: a scene stored
+/// relative to an origin of its own (`Scene::origin`) gets them relative
+/// to it, rounded to f32 only then.
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
     #[serde(rename = "type")]
     pub kind: String,
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     #[serde(default)]
     pub direction: Option<[f32; 3]>,
     #[serde(default)]
@@ -155,9 +161,9 @@ pub struct LightSpec {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     /// Vertical field of view, degrees.
     #[serde(default)]
     pub fov: Option<f32>,
@@ -175,9 +181,9 @@ pub struct CameraSpec {
 pub struct Key {
     pub t: f32,
     #[serde(default)]
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     #[serde(default)]
-    pub target: Option<[f32; 3]>,
+    pub target: Option<[f64; 3]>,
     #[serde(default)]
     pub direction: Option<[f32; 3]>,
 }
@@ -188,7 +194,7 @@ pub struct Key {
 pub struct Orbit {
     pub period: f32,
     #[serde(default)]
-    pub center: Option<[f32; 3]>,
+    pub center: Option<[f64; 3]>,
     #[serde(default)]
     pub turns: Option<f32>,
 }
@@ -216,14 +222,18 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             super::limits::bytes(options.limits.description_bytes)
         );
     }
+    // A byte-order mark (editors on Windows write one) is no JSON value.
+    let bytes = super::text::strip_bom(bytes);
     let d: Description = serde_json::from_slice(bytes).map_err(|e| {
         let at = format!(" at line {} column {}", e.line(), e.column());
         let message = e.to_string();
+        // serde's message quotes the file (an unknown field's name, a
+        // string of the wrong type): escaped and cut like any file text.
         anyhow!(
             "line {} column {}: {} (the format: README, \"Scenes from the archives\")",
             e.line(),
             e.column(),
-            message.strip_suffix(&at).unwrap_or(&message)
+            super::text::quote_at_most(message.strip_suffix(&at).unwrap_or(&message), 300)
         )
     })?;
     let folder = path
@@ -233,15 +243,15 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
     let allow = options.allow_outside_uris;
     let mesh = match &d.mesh {
         serde_json::Value::String(name) => files::resolve(name, Path::new(""), &folder, allow)
-            .with_context(|| format!("mesh {name}"))?,
+            .with_context(|| format!("mesh {}", super::text::quote(name)))?,
         serde_json::Value::Object(o) if o.len() == 1 && o.get("archive").is_some_and(|v| v.is_string()) => {
             let name = o["archive"].as_str().unwrap_or_default();
             let root = archive_root();
             if !root.is_dir() {
-                bail!("mesh {{\"archive\": {name:?}}}: {} is not a folder; {}", root.display(), archive_hint());
+                bail!("mesh {{\"archive\": \"{}\"}}: {} is not a folder; {}", super::text::quote(name), root.display(), archive_hint());
             }
             files::resolve(name, Path::new(""), &root, allow).with_context(|| {
-                format!("mesh {{\"archive\": {name:?}}} in {} ({})", root.display(), archive_hint())
+                format!("mesh {{\"archive\": \"{}\"}} in {} ({})", super::text::quote(name), root.display(), archive_hint())
             })?
         }
         other => bail!(
@@ -290,7 +300,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         let l = fitted_light(lo, hi);
         scene.warnings.push(format!(
             "the description has no lights: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd)",
-            l.position.to_array(),
+            (scene.origin + l.position.as_dvec3()).to_array(),
             l.intensity
         ));
         scene.lights = vec![l];
@@ -330,7 +340,8 @@ pub fn apply(
         animation.lights.clear();
         scene.lights.clear();
         for (i, (label, spec)) in lights.iter().enumerate() {
-            let (light, motion) = light(spec, pivot).with_context(|| label.clone())?;
+            let (light, motion) =
+                light(spec, pivot, scene.origin).with_context(|| label.clone())?;
             scene.lights.push(light);
             if let Some(keys) = motion {
                 let node = add_path(&mut animation, &keys).with_context(|| label.clone())?;
@@ -340,7 +351,7 @@ pub fn apply(
     }
     if let Some(c) = camera {
         animation.camera = None;
-        let (cam, motion) = self::camera(c, pivot, diagonal).context("camera")?;
+        let (cam, motion) = self::camera(c, pivot, diagonal, scene.origin).context("camera")?;
         scene.camera = cam;
         if let Some(keys) = motion {
             let node = add_path(&mut animation, &keys).context("camera")?;
@@ -364,7 +375,10 @@ fn up_rotation(up: &str) -> Result<glam::Quat> {
         "-z" => glam::Quat::from_rotation_x(FRAC_PI_2),
         "+x" | "x" => glam::Quat::from_rotation_z(FRAC_PI_2),
         "-x" => glam::Quat::from_rotation_z(-FRAC_PI_2),
-        other => bail!("up {other:?}: the file's up axis is one of +y, -y, +z, -z, +x, -x"),
+        _ => bail!(
+            "up '{}': the file's up axis is one of +y, -y, +z, -z, +x, -x",
+            super::text::quote(up)
+        ),
     })
 }
 
@@ -396,6 +410,9 @@ fn place(scene: &mut Scene, m: Mat4, scale: f32) {
         c.world_from_camera = w;
     }
     c.znear *= scale;
+    // The scene's own origin is placed too (a rotation and a scale: no
+    // translation), in f64.
+    scene.origin = m.as_dmat4().transform_point3(scene.origin);
 }
 
 /// The coordinate budget and the smallest scene, after placement.
@@ -403,7 +420,10 @@ fn check_reach(scene: &Scene, options: &LoadOptions) -> Result<()> {
     let (lo, hi) = scene
         .bounds()
         .ok_or_else(|| anyhow!("the mesh has no vertices"))?;
-    let reach = lo.abs().max(hi.abs()).max_element();
+    let o = scene.origin;
+    let reach = ((o + lo.as_dvec3()).abs())
+        .max((o + hi.as_dvec3()).abs())
+        .max_element() as f32;
     let limits = &options.limits;
     if reach.is_nan() || reach > limits.coordinate {
         bail!(
@@ -480,397 +500,4 @@ fn add_room(scene: &mut Scene, room: &Room) -> Result<()> {
         m,
     );
     Ok(())
-}
-
-fn vec3(a: [f32; 3], what: &str) -> Result<Vec3> {
-    let v = Vec3::from(a);
-    if !v.is_finite() {
-        bail!("{what} {a:?} is not finite");
-    }
-    Ok(v)
-}
-
-/// A position, within the coordinate budget (`Limits::coordinate`).
-fn point(a: [f32; 3], what: &str) -> Result<Vec3> {
-    let v = vec3(a, what)?;
-    let limit = super::limits::Limits::DEFAULT.coordinate;
-    if v.abs().max_element() > limit {
-        bail!("{what} {a:?} reaches beyond {limit:.0e} m, the largest coordinate isr supports");
-    }
-    Ok(v)
-}
-
-/// One keyframe resolved: time, position, where it points.
-struct Pose {
-    t: f32,
-    position: Vec3,
-    direction: Vec3,
-}
-
-fn light(spec: &LightSpec, pivot: Vec3) -> Result<(Light, Option<Vec<Pose>>)> {
-    let kind = match spec.kind.trim().to_ascii_lowercase().as_str() {
-        "spot" => LightKind::Spot,
-        "point" => LightKind::Point,
-        "directional" | "sun" => LightKind::Directional,
-        other => bail!("type {other:?}: a light is spot, point or directional"),
-    };
-    let first = spec.path.as_ref().and_then(|p| p.first());
-    let position = spec.position.or(first.and_then(|k| k.position));
-    let target = spec.target.or(first.and_then(|k| k.target));
-    let direction = spec.direction.or(first.and_then(|k| k.direction));
-    let (position, direction) = match kind {
-        LightKind::Directional => {
-            if spec.target.is_some() && direction.is_none() {
-                let p = vec3(position.ok_or_else(|| anyhow!("a directional light with a target needs a position (the rays go from it to the target), or give its direction"))?, "position")?;
-                let t = vec3(target.unwrap_or_default(), "target")?;
-                (p, t - p)
-            } else {
-                let d = direction.ok_or_else(|| {
-                    anyhow!("a directional light needs a direction (its rays, e.g. [0.3, -1, 0.2])")
-                })?;
-                (
-                    position.map_or(Ok(pivot), |p| vec3(p, "position"))?,
-                    vec3(d, "direction")?,
-                )
-            }
-        }
-        LightKind::Spot | LightKind::Point => {
-            let p = point(
-                position.ok_or_else(|| anyhow!("a {} light needs a position", spec.kind))?,
-                "position",
-            )?;
-            let d = match (target, direction) {
-                (Some(t), _) => point(t, "target")? - p,
-                (None, Some(d)) => vec3(d, "direction")?,
-                (None, None) if kind == LightKind::Point => -Vec3::Y,
-                (None, None) => bail!("a spot light needs a target (or a direction) to point at"),
-            };
-            (p, d)
-        }
-    };
-    let Some(direction) = direction.try_normalize() else {
-        bail!("the light points nowhere: its target is its position (or its direction is zero)");
-    };
-    let color = vec3(spec.color.unwrap_or([1.0; 3]), "color")?;
-    if color.min_element() < 0.0 {
-        bail!("color {color}: must be non-negative");
-    }
-    let outer = spec.cone.unwrap_or(45.0);
-    let inner = spec.inner_cone.unwrap_or(outer * 0.75);
-    if kind == LightKind::Spot && !(inner >= 0.0 && inner < outer && outer <= 90.0) {
-        bail!(
-            "cone {outer}, inner_cone {inner} (degrees): they must satisfy 0 <= inner < outer <= 90"
-        );
-    }
-    // Default intensity: a white surface facing the light at the target (or
-    // at the scene's centre) reflects radiance 1: E = pi.
-    let reach = match kind {
-        LightKind::Directional => 1.0,
-        _ => {
-            let aim = target.map(Vec3::from).unwrap_or(pivot);
-            (aim - position).length().max(1e-6)
-        }
-    };
-    let intensity = spec
-        .intensity
-        .unwrap_or(std::f32::consts::PI * reach * reach);
-    if !(intensity.is_finite() && intensity >= 0.0 && (color * intensity).is_finite()) {
-        bail!("intensity {intensity}: must be finite and non-negative");
-    }
-    if let Some(r) = spec.range {
-        if !(r.is_finite() && r > 0.0) {
-            bail!("range {r}: must be finite and positive");
-        }
-    }
-    let light = Light {
-        kind,
-        position,
-        direction,
-        color,
-        intensity,
-        inner_cone: if kind == LightKind::Spot {
-            inner.to_radians()
-        } else {
-            0.0
-        },
-        outer_cone: if kind == LightKind::Spot {
-            outer.to_radians()
-        } else {
-            std::f32::consts::FRAC_PI_2
-        },
-        range: spec.range,
-    };
-    let motion = motion(
-        spec.path.as_deref(),
-        spec.orbit.as_ref(),
-        Pose {
-            t: 0.0,
-            position,
-            direction,
-        },
-        target.map(Vec3::from),
-        kind == LightKind::Directional,
-        pivot,
-    )?;
-    Ok((light, motion))
-}
-
-fn camera(spec: &CameraSpec, pivot: Vec3, diagonal: f32) -> Result<(Camera, Option<Vec<Pose>>)> {
-    let first = spec.path.as_ref().and_then(|p| p.first());
-    let position = spec
-        .position
-        .or(first.and_then(|k| k.position))
-        .ok_or_else(|| anyhow!("the camera needs a position"))?;
-    let position = point(position, "position")?;
-    let target = spec.target.or(first.and_then(|k| k.target));
-    let target = match target {
-        Some(t) => point(t, "target")?,
-        None => pivot,
-    };
-    let Some(direction) = (target - position).try_normalize() else {
-        bail!("the camera's target is its position: it looks nowhere");
-    };
-    let fov = spec.fov.unwrap_or(45.0);
-    if !(fov > 0.0 && fov < 180.0) {
-        bail!("fov {fov}: the vertical field of view is more than 0 and less than 180 degrees");
-    }
-    let far = (diagonal + (position - pivot).length()).max(f32::MIN_POSITIVE);
-    let znear = spec
-        .znear
-        .unwrap_or((diagonal * 1e-3).max(f32::MIN_POSITIVE));
-    if !(znear.is_normal() && znear > 0.0) {
-        bail!("znear {znear}: must be a positive number of metres");
-    }
-    if (znear as f64) < far as f64 * 1e-30 {
-        bail!("znear {znear} is too small for a scene reaching {far:.3e} m from the camera: depths would underflow (use znear >= {:.1e})", far as f64 * 1e-30);
-    }
-    let camera = Camera {
-        world_from_camera: Mat4::from_rotation_translation(
-            rotation_looking_along(direction),
-            position,
-        ),
-        yfov: fov.to_radians(),
-        znear,
-    };
-    let motion = motion(
-        spec.path.as_deref(),
-        spec.orbit.as_ref(),
-        Pose {
-            t: 0.0,
-            position,
-            direction,
-        },
-        Some(target),
-        false,
-        pivot,
-    )?;
-    Ok((camera, motion))
-}
-
-/// The keyframes of a path or an orbit (none without either).
-fn motion(
-    path: Option<&[Key]>,
-    orbit: Option<&Orbit>,
-    rest: Pose,
-    target: Option<Vec3>,
-    directional: bool,
-    pivot: Vec3,
-) -> Result<Option<Vec<Pose>>> {
-    match (path, orbit) {
-        (None, None) => Ok(None),
-        (Some(_), Some(_)) => bail!("give a path or an orbit, not both"),
-        (Some(keys), None) => {
-            if keys.is_empty() {
-                bail!("the path has no keyframes");
-            }
-            let mut out = Vec::with_capacity(keys.len());
-            let (mut position, mut target, mut direction) = (rest.position, target, rest.direction);
-            for (i, k) in keys.iter().enumerate() {
-                let what = |f: &str| format!("path key {i}: {f}");
-                if !k.t.is_finite() {
-                    bail!("{}", what(&format!("t {} is not finite", k.t)));
-                }
-                if let Some(p) = k.position {
-                    position = point(p, &what("position"))?;
-                }
-                if let Some(t) = k.target {
-                    target = Some(point(t, &what("target"))?);
-                }
-                if let Some(d) = k.direction {
-                    direction = vec3(d, &what("direction"))?;
-                } else if let Some(t) = target {
-                    if !directional {
-                        direction = t - position;
-                    }
-                }
-                let Some(d) = direction.try_normalize() else {
-                    bail!("{}", what("the target is the position: it points nowhere"));
-                };
-                out.push(Pose {
-                    t: k.t,
-                    position,
-                    direction: d,
-                });
-            }
-            Ok(Some(out))
-        }
-        (None, Some(o)) => {
-            if !(o.period.is_finite() && o.period > 0.0) {
-                bail!("orbit period {}: a positive number of seconds", o.period);
-            }
-            let turns = o.turns.unwrap_or(1.0);
-            if !(turns.is_finite() && turns > 0.0 && turns <= 1000.0) {
-                bail!("orbit turns {turns}: a positive number, at most 1000");
-            }
-            let center = match o.center {
-                Some(c) => vec3(c, "orbit center")?,
-                None => pivot,
-            };
-            let aim = if directional {
-                None
-            } else {
-                Some(target.unwrap_or_else(|| {
-                    super::motion::aim_point(rest.position, rest.direction, center)
-                }))
-            };
-            // 64 keys a turn: linear between them, the path is within 0.12%
-            // of the radius of the circle.
-            let n = (64.0 * turns).ceil() as usize;
-            let out = (0..=n)
-                .map(|k| {
-                    let s = k as f32 / n as f32 * turns;
-                    let rot = glam::Quat::from_rotation_y(std::f32::consts::TAU * s);
-                    let position = center + rot * (rest.position - center);
-                    let direction = match aim {
-                        Some(a) => (a - position).normalize_or(rot * rest.direction),
-                        None => rot * rest.direction,
-                    };
-                    Pose {
-                        t: s * o.period,
-                        position,
-                        direction,
-                    }
-                })
-                .collect();
-            Ok(Some(out))
-        }
-    }
-}
-
-/// A node of `a` moving along `keys` (translation and rotation, linear):
-/// its index.
-fn add_path(a: &mut Animation, keys: &[Pose]) -> Result<usize> {
-    let rest = Trs {
-        translation: keys[0].position,
-        rotation: rotation_looking_along(keys[0].direction),
-        scale: Vec3::ONE,
-    };
-    let node = a
-        .add_node(Parent::Fixed(Mat4::IDENTITY), Local::Animated(rest))
-        .map_err(|e| anyhow!(e))?;
-    let times: Vec<f32> = keys.iter().map(|k| k.t).collect();
-    let translations = keys.iter().map(|k| k.position.extend(0.0)).collect();
-    let rotations = keys
-        .iter()
-        .map(|k| Vec4::from(rotation_looking_along(k.direction)))
-        .collect();
-    for (property, values) in [
-        (Property::Translation, translations),
-        (Property::Rotation, rotations),
-    ] {
-        let c = Channel::new(node, property, Interpolation::Linear, times.clone(), values)
-            .map_err(|e| anyhow!("the path: {e}"))?;
-        a.add_channel(c.labelled(format!("the path's {}", property.name())))
-            .map_err(|e| anyhow!(e))?;
-    }
-    Ok(node)
-}
-
-/// `--light`: `KIND:KEY=VALUE:...`, KIND spot, point or directional; keys
-/// `position` (`pos`), `target`, `direction` (`dir`), `intensity`,
-/// `color`, `cone`, `inner` (degrees), `range`; vectors as `X,Y,Z`.
-pub fn parse_light(s: &str) -> Result<LightSpec, String> {
-    let mut parts = s.split(':');
-    let kind = parts.next().unwrap_or_default().trim().to_string();
-    if !matches!(
-        kind.to_ascii_lowercase().as_str(),
-        "spot" | "point" | "directional" | "sun"
-    ) {
-        return Err(format!(
-            "'{kind}': a light starts with its type, spot, point or directional (e.g. spot:position=0,4,0:target=0,0,0:cone=40)"
-        ));
-    }
-    let mut l = LightSpec {
-        kind,
-        ..Default::default()
-    };
-    for part in parts {
-        let (key, value) = key_value(part)?;
-        match key {
-            "position" | "pos" => l.position = Some(vector(key, value)?),
-            "target" => l.target = Some(vector(key, value)?),
-            "direction" | "dir" => l.direction = Some(vector(key, value)?),
-            "color" | "colour" => l.color = Some(vector(key, value)?),
-            "intensity" => l.intensity = Some(number(key, value)?),
-            "cone" => l.cone = Some(number(key, value)?),
-            "inner" | "inner_cone" => l.inner_cone = Some(number(key, value)?),
-            "range" => l.range = Some(number(key, value)?),
-            _ => {
-                return Err(format!(
-                    "'{key}': a light takes position, target, direction, intensity, color, cone, inner and range"
-                ))
-            }
-        }
-    }
-    // The checks that need no scene, now: before a device is opened.
-    light(&l, Vec3::ZERO).map_err(|e| format!("{e:#}"))?;
-    Ok(l)
-}
-
-/// `--camera`: `KEY=VALUE:...`, keys `position` (`pos`), `target`, `fov`
-/// (vertical, degrees), `znear` (metres).
-pub fn parse_camera(s: &str) -> Result<CameraSpec, String> {
-    let mut c = CameraSpec::default();
-    for part in s.split(':') {
-        let (key, value) = key_value(part)?;
-        match key {
-            "position" | "pos" => c.position = Some(vector(key, value)?),
-            "target" => c.target = Some(vector(key, value)?),
-            "fov" => c.fov = Some(number(key, value)?),
-            "znear" => c.znear = Some(number(key, value)?),
-            _ => {
-                return Err(format!(
-                    "'{key}': the camera takes position, target, fov and znear"
-                ))
-            }
-        }
-    }
-    if c.position.is_none() {
-        return Err("the camera needs a position (position=X,Y,Z)".into());
-    }
-    camera(&c, Vec3::ZERO, 1.0).map_err(|e| format!("{e:#}"))?;
-    Ok(c)
-}
-
-fn key_value(part: &str) -> Result<(&str, &str), String> {
-    part.split_once('=')
-        .map(|(k, v)| (k.trim(), v.trim()))
-        .ok_or_else(|| format!("'{part}': expected KEY=VALUE"))
-}
-
-fn number(key: &str, value: &str) -> Result<f32, String> {
-    value
-        .parse::<f32>()
-        .ok()
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| format!("{key}={value}: not a finite number"))
-}
-
-fn vector(key: &str, value: &str) -> Result<[f32; 3], String> {
-    let v: Vec<f32> = value
-        .split(',')
-        .map(|x| number(key, x.trim()))
-        .collect::<Result<_, _>>()?;
-    v.try_into()
-        .map_err(|_| format!("{key}={value}: a vector is X,Y,Z"))
 }
