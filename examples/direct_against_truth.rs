@@ -2,13 +2,15 @@
 //! the relative RMSE of the rasterized direct image against `pathtrace`'s
 //! direct layer (exact shadow rays, noise-free), over the truth mask
 //! (section 6.6: away from geometric edges and from the shadow band PCF
-//! blurs), at each RSM resolution, for
+//! blurs), at each RSM resolution, with the shadow map of its own size
+//! (`RenderSettings::shadow_size`) and, with `--shadow-as-rsm`, as it was
+//! when the RSM's depth was the shadow map (the RSM's size and square), for
 //! - `sibenik`: the Sibenik nave under its spot (`assets/archive/sibenik.scene.json`, t = 0);
 //! - `sponza`: the Sponza atrium under its sun (`assets/archive/sponza.scene.json`, t = 0);
 //! - `court`: the sun-lit court of `tests/shadow_leaks.rs` under each of its three low suns.
 //!
 //! ```text
-//! cargo run --release --example direct_against_truth [-- [--size N] [--rsm 128,256,...] [--scenes a,b] [--dump DIR]]
+//! cargo run --release --example direct_against_truth [-- [--size N] [--rsm 128,256,...] [--scenes a,b] [--dump DIR] [--shadow-as-rsm]]
 //! ```
 //!
 //! Default: 512x512 (`isr render`'s size), RSM 128 to 2048, every scene.
@@ -16,7 +18,9 @@
 //! compared pixels lit where the path tracer has shadow (leaks, direct
 //! light over 1% of the scene's mean). `--dump DIR` writes a PNG per
 //! scene and RSM: the path tracer's direct light in grey, leaks in red,
-//! pixels left out of the comparison in blue.
+//! pixels left out of the comparison in blue. A last column gives the
+//! median GPU time of passes `shadow` and `rsm` over 3 frames at the
+//! largest RSM.
 
 use anyhow::{bail, Context, Result};
 use isr::bench::metrics::relative_rmse;
@@ -36,6 +40,7 @@ struct Args {
     rsm: Vec<u32>,
     scenes: Vec<String>,
     dump: Option<std::path::PathBuf>,
+    as_rsm: bool,
 }
 
 fn args() -> Result<Args> {
@@ -44,18 +49,18 @@ fn args() -> Result<Args> {
         rsm: vec![128, 256, 512, 1024, 2048],
         scenes: vec!["sibenik".into(), "sponza".into(), "court".into()],
         dump: None,
+        as_rsm: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
+        if flag == "--shadow-as-rsm" {
+            a.as_rsm = true;
+            continue;
+        }
         let value = it.next().with_context(|| format!("{flag} needs a value"))?;
         match flag.as_str() {
             "--size" => a.size = value.parse()?,
-            "--rsm" => {
-                a.rsm = value
-                    .split(',')
-                    .map(str::parse)
-                    .collect::<Result<_, _>>()?
-            }
+            "--rsm" => a.rsm = value.split(',').map(str::parse).collect::<Result<_, _>>()?,
             "--scenes" => a.scenes = value.split(',').map(String::from).collect(),
             "--dump" => a.dump = Some(value.into()),
             _ => bail!("unknown option {flag}"),
@@ -84,15 +89,38 @@ fn scenes(name: &str) -> Result<Vec<(String, Scene)>> {
     })
 }
 
-/// Direct light only (`--method none`) at `size` x `size`, RSM `rsm`.
-fn settings(size: u32, rsm: u32) -> RenderSettings {
+/// Direct light only (`--method none`) at `size` x `size`, RSM `rsm`; with
+/// `as_rsm` the shadow map at the RSM's size and square.
+fn settings(size: u32, rsm: u32, as_rsm: bool) -> RenderSettings {
     RenderSettings {
         width: size,
         height: size,
         rsm_resolution: rsm,
+        shadow_resolution: if as_rsm { rsm } else { 0 },
+        fit_sun_shadow: !as_rsm,
         method: Method::new("none"),
         ..Default::default()
     }
+}
+
+/// Median GPU milliseconds of passes `shadow` and `rsm` (summed over light
+/// views) over 3 frames of `scene` at `s`.
+fn pass_ms(gpu: &Gpu, scene: &Scene, s: &RenderSettings) -> Result<(f64, f64)> {
+    let mut r = Renderer::new(gpu, scene, s)?;
+    let stats = r.render_frames(4, |_| {})?;
+    let of = |name: &str| {
+        let per_frame: Vec<f64> = stats
+            .timed()
+            .map(|f| {
+                f.iter()
+                    .filter(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
+                    .filter_map(|p| p.gpu_ms)
+                    .sum()
+            })
+            .collect();
+        isr::renderer::median(&per_frame).unwrap_or(f64::NAN)
+    };
+    Ok((of("shadow"), of("rsm")))
 }
 
 /// The error of `scene`'s direct light at `s` against `traced`, and the
@@ -108,7 +136,7 @@ fn measure(
     r.render_frames(1, |_| {})?;
     let raster = r.readback()?;
     let views = r.light_views().to_vec();
-    let shadows = ShadowMaps::new(&views, r.render_origin(), s.rsm_resolution, s.pcf_radius);
+    let shadows = ShadowMaps::new(&views, r.render_origin(), s.shadow_size(), s.pcf_radius);
     drop(r);
     let compared = truth_mask(&raster, &traced.direct, &shadows);
     let mask = &compared.mask;
@@ -141,7 +169,8 @@ fn main() -> Result<()> {
     for r in &a.rsm {
         header += &format!(" `--rsm {r}` |");
     }
-    println!("{header}\n|---|{}", "---|".repeat(a.rsm.len()));
+    header += " `shadow` / `rsm` ms |";
+    println!("{header}\n|---|{}", "---|".repeat(a.rsm.len() + 1));
     for name in &a.scenes {
         for (label, scene) in scenes(name)? {
             let traced = isr::pathtrace::render(
@@ -152,6 +181,7 @@ fn main() -> Result<()> {
                     spp: 1,
                     seed: 1,
                     exposure: 1.0,
+                    bounces: isr::bounces::Bounces::ONE,
                 },
                 |_, _| {},
             );
@@ -167,10 +197,13 @@ fn main() -> Result<()> {
                 if let Some(d) = &a.dump {
                     std::fs::create_dir_all(d)?;
                 }
-                let s = settings(a.size, rsm);
+                let s = settings(a.size, rsm, a.as_rsm);
                 let (e, leaks) = measure(&gpu, &scene, &s, &traced, dump.as_deref())?;
                 row += &format!(" {:.1}% / {:.2}% |", 100.0 * e, 100.0 * leaks);
             }
+            let last = settings(a.size, *a.rsm.iter().max().unwrap_or(&512), a.as_rsm);
+            let (shadow, rsm) = pass_ms(&gpu, &scene, &last)?;
+            row += &format!(" {shadow:.1} / {rsm:.1} |");
             println!("{row}");
         }
     }

@@ -95,7 +95,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", grid_cube: 16, [
+        check!(shader, FrameUniforms, "FrameUniforms", shadow_view_proj: 64, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -114,10 +114,11 @@ fn frame_uniforms_match_shared_glsl() {
             rsm_depth_range => "rsm_depth_range",
             cube_face => "cube_face",
             light_index => "light_index",
-            pad2 => "pad2",
+            shadow_half_extent => "shadow_half_extent",
             pad3 => "pad3",
             cube_view_proj => "cube_view_proj",
             grid_cube => "grid_cube",
+            shadow_view_proj => "shadow_view_proj",
         ]);
     }
 }
@@ -147,7 +148,7 @@ fn run_uniforms_match_shared_glsl() {
             patch_kernel => "patch_kernel",
             grid_side => "grid_side",
             grid_levels => "grid_levels",
-            pad0 => "pad0",
+            shadow_resolution => "shadow_resolution",
             pad1 => "pad1",
             pad2 => "pad2",
         ]);

@@ -37,7 +37,7 @@ fn rendered_and_traced(
     let shadows = ShadowMaps::new(
         &rendered.light_views,
         rendered.origin,
-        settings.rsm_resolution,
+        settings.shadow_size(),
         settings.pcf_radius,
     );
     let mask = truth_mask(&rendered.readback, &traced.direct, &shadows);
