@@ -5,12 +5,12 @@
 //! blurs), at each RSM resolution, with the shadow map of its own size
 //! (`RenderSettings::shadow_size`) and, with `--shadow-as-rsm`, as it was
 //! when the RSM's depth was the shadow map (the RSM's size and square), for
-//! - `sibenik`: the Sibenik nave under its spot (`assets/archive/sibenik.scene.json`, t = 0);
+//! - `sibenik`: the Sibenik nave of `tests/shadow_leaks.rs` under its spot and its point light;
 //! - `sponza`: the Sponza atrium under its sun (`assets/archive/sponza.scene.json`, t = 0);
 //! - `court`: the sun-lit court of `tests/shadow_leaks.rs` under each of its three low suns.
 //!
 //! ```text
-//! cargo run --release --example direct_against_truth [-- [--size N] [--rsm 128,256,...] [--scenes a,b] [--dump DIR] [--shadow-as-rsm]]
+//! cargo run --release --example direct_against_truth [-- [--size N] [--rsm 128,256,...] [--scenes a,b] [--dump DIR] [--shadow N | --shadow-as-rsm]]
 //! ```
 //!
 //! Default: 512x512 (`isr render`'s size), RSM 128 to 2048, every scene.
@@ -34,6 +34,8 @@ use isr::vk::{Gpu, GpuOptions};
 
 #[path = "../tests/common/court.rs"]
 mod court;
+#[path = "../tests/common/sibenik.rs"]
+mod sibenik;
 
 struct Args {
     size: u32,
@@ -41,6 +43,7 @@ struct Args {
     scenes: Vec<String>,
     dump: Option<std::path::PathBuf>,
     as_rsm: bool,
+    shadow: u32,
 }
 
 fn args() -> Result<Args> {
@@ -50,6 +53,7 @@ fn args() -> Result<Args> {
         scenes: vec!["sibenik".into(), "sponza".into(), "court".into()],
         dump: None,
         as_rsm: false,
+        shadow: 0,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -63,23 +67,36 @@ fn args() -> Result<Args> {
             "--rsm" => a.rsm = value.split(',').map(str::parse).collect::<Result<_, _>>()?,
             "--scenes" => a.scenes = value.split(',').map(String::from).collect(),
             "--dump" => a.dump = Some(value.into()),
+            "--shadow" => a.shadow = value.parse()?,
             _ => bail!("unknown option {flag}"),
         }
     }
     Ok(a)
 }
 
-/// The scenes by name: each a label and its scene.
-fn scenes(name: &str) -> Result<Vec<(String, Scene)>> {
+/// The scenes by name: each a label and its scene (`indexing`: whether the
+/// device indexes texture arrays).
+fn scenes(name: &str, indexing: bool) -> Result<Vec<(String, Scene)>> {
     let archive = |file: &str| -> Result<Scene> {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("assets/archive")
             .join(file);
-        isr::scene::load_file(&path, &Default::default())
-            .with_context(isr::scene::description::archive_hint)
+        let mut s = isr::scene::load_file(&path, &Default::default())
+            .with_context(isr::scene::description::archive_hint)?;
+        if !indexing {
+            isr::scene::one_texture::keep_one(&mut s);
+        }
+        Ok(s)
     };
     Ok(match name {
-        "sibenik" => vec![("Sibenik nave, spot".into(), archive("sibenik.scene.json")?)],
+        "sibenik" => sibenik::lights()
+            .into_iter()
+            .map(|(name, light)| {
+                let mut s = sibenik::nave(indexing)?;
+                s.lights = vec![light];
+                Ok((format!("Sibenik, {name}"), s))
+            })
+            .collect::<Result<_>>()?,
         "sponza" => vec![("Sponza atrium, sun".into(), archive("sponza.scene.json")?)],
         "court" => court::low_suns()
             .into_iter()
@@ -89,14 +106,16 @@ fn scenes(name: &str) -> Result<Vec<(String, Scene)>> {
     })
 }
 
-/// Direct light only (`--method none`) at `size` x `size`, RSM `rsm`; with
-/// `as_rsm` the shadow map at the RSM's size and square.
-fn settings(size: u32, rsm: u32, as_rsm: bool) -> RenderSettings {
+/// Direct light only (`--method none`) at `--size`, RSM `rsm`; with
+/// `--shadow-as-rsm` the shadow map at the RSM's size and square, else at
+/// `--shadow` (0: its default).
+fn settings(a: &Args, rsm: u32) -> RenderSettings {
+    let (size, as_rsm) = (a.size, a.as_rsm);
     RenderSettings {
         width: size,
         height: size,
         rsm_resolution: rsm,
-        shadow_resolution: if as_rsm { rsm } else { 0 },
+        shadow_resolution: if as_rsm { rsm } else { a.shadow },
         fit_sun_shadow: !as_rsm,
         method: Method::new("none"),
         ..Default::default()
@@ -172,7 +191,7 @@ fn main() -> Result<()> {
     header += " `shadow` / `rsm` ms |";
     println!("{header}\n|---|{}", "---|".repeat(a.rsm.len() + 1));
     for name in &a.scenes {
-        for (label, scene) in scenes(name)? {
+        for (label, scene) in scenes(name, gpu.features.sampled_image_array_indexing)? {
             let traced = isr::pathtrace::render(
                 &scene,
                 &PathTraceSettings {
@@ -197,11 +216,11 @@ fn main() -> Result<()> {
                 if let Some(d) = &a.dump {
                     std::fs::create_dir_all(d)?;
                 }
-                let s = settings(a.size, rsm, a.as_rsm);
+                let s = settings(&a, rsm);
                 let (e, leaks) = measure(&gpu, &scene, &s, &traced, dump.as_deref())?;
                 row += &format!(" {:.1}% / {:.2}% |", 100.0 * e, 100.0 * leaks);
             }
-            let last = settings(a.size, *a.rsm.iter().max().unwrap_or(&512), a.as_rsm);
+            let last = settings(&a, *a.rsm.iter().max().unwrap_or(&512));
             let (shadow, rsm) = pass_ms(&gpu, &scene, &last)?;
             row += &format!(" {shadow:.1} / {rsm:.1} |");
             println!("{row}");

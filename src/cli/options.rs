@@ -92,7 +92,7 @@ pub struct RunArgs {
     #[arg(long, default_value_t = D.rsm_resolution, help_heading = "Size")]
     pub rsm: u32,
     /// Shadow map resolution S of the direct light (S x S, a power of two;
-    /// default: 4 texels per pixel of the longer image side, 1024 to 4096).
+    /// default: 8 texels per pixel of the longer image side, 1024 to 4096).
     #[arg(long, value_name = "N", help_heading = "Size", hide_short_help = true)]
     pub shadow: Option<u32>,
     /// Multiplier on radiance before the PNG's sRGB encoding.

@@ -4,7 +4,8 @@
 //! KHR_lights_punctual (not the library's own `Light` methods), CPU sums,
 //! and the bench's error measures (`isr::bench::metrics`). Submodules:
 //! `cli`, the one runner of the `isr` binary; `court`, the sun-lit court of
-//! the shadow tests; `gltf`, the one builder of
+//! the shadow tests; `sibenik`, the Sibenik nave of the shadow tests;
+//! `gltf`, the one builder of
 //! glTF and GLB files; `grid`, the voxel visibility settings and the grid
 //! read back; `measure`, work counted on this thread (allocations,
 //! bytes read).
@@ -18,6 +19,7 @@ pub mod court;
 pub mod gltf;
 pub mod grid;
 pub mod measure;
+pub mod sibenik;
 
 // Every test binary compiles this kit; most use no grid helper.
 #[allow(unused_imports)]
