@@ -74,25 +74,20 @@ fn args() -> Result<Args> {
     Ok(a)
 }
 
-/// The scenes by name: each a label and its scene (`indexing`: whether the
-/// device indexes texture arrays).
-fn scenes(name: &str, indexing: bool) -> Result<Vec<(String, Scene)>> {
+/// The scenes by name: each a label and its scene.
+fn scenes(name: &str) -> Result<Vec<(String, Scene)>> {
     let archive = |file: &str| -> Result<Scene> {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("assets/archive")
             .join(file);
-        let mut s = isr::scene::load_file(&path, &Default::default())
-            .with_context(isr::scene::description::archive_hint)?;
-        if !indexing {
-            isr::scene::one_texture::keep_one(&mut s);
-        }
-        Ok(s)
+        isr::scene::load_file(&path, &Default::default())
+            .with_context(isr::scene::description::archive_hint)
     };
     Ok(match name {
         "sibenik" => sibenik::lights()
             .into_iter()
             .map(|(name, light)| {
-                let mut s = sibenik::nave(indexing)?;
+                let mut s = sibenik::nave()?;
                 s.lights = vec![light];
                 Ok((format!("Sibenik, {name}"), s))
             })
@@ -191,7 +186,7 @@ fn main() -> Result<()> {
     header += " `shadow` / `rsm` ms |";
     println!("{header}\n|---|{}", "---|".repeat(a.rsm.len() + 1));
     for name in &a.scenes {
-        for (label, scene) in scenes(name, gpu.features.sampled_image_array_indexing)? {
+        for (label, scene) in scenes(name)? {
             let traced = isr::pathtrace::render(
                 &scene,
                 &PathTraceSettings {

@@ -121,13 +121,14 @@ const uint GEO_HAS_GEOMETRY = 1u;  // at least one pixel of the texel sees geome
 const uint GEO_SMOOTH = 2u;        // fully covered, depth range and normal spread under the thresholds
 const uint GEO_SPLIT = 4u;         // has geometry and is not a leaf: not smooth, or 2:1 balance
 
-// One glTF material (std430 storage buffer, set 0, binding 1 of scene passes).
+// One material (std430 storage buffer, set 1, binding 0 of scene passes).
 struct MaterialGpu {
-    vec4 base_color;  // linear RGBA albedo factor
-    int texture;      // index into the scene texture array, -1 for none
-    int pad0;
-    int pad1;
-    int pad2;
+    vec4 base_color;     // linear RGBA albedo factor
+    int texture_array;    // the texture's array (texture_array_N of material.glsl), -1 for none
+    int texture_layer;    // its layer in that array
+    vec2 texture_scale;   // where in the layer the texture is: sampled at
+    vec2 texture_offset;  // fract(uv) * texture_scale + texture_offset
+    vec2 pad0;
 };
 
 // Push constants of one dispatch of pass visibility-grid (voxel_grid/voxelize.comp):

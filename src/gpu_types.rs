@@ -173,11 +173,15 @@ pub const GEO_SPLIT: u32 = 4;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MaterialGpu {
     pub base_color: [f32; 4],
-    /// Texture index, -1 for none.
-    pub texture: i32,
-    pub pad0: i32,
-    pub pad1: i32,
-    pub pad2: i32,
+    /// The texture's array (`frame::texture_arrays`), -1 for none.
+    pub texture_array: i32,
+    /// Its layer in that array.
+    pub texture_layer: i32,
+    /// Where in the layer the texture is: sampled at `fract(uv) * scale +
+    /// offset` (`TexturePlan::transform`).
+    pub texture_scale: [f32; 2],
+    pub texture_offset: [f32; 2],
+    pub pad0: [f32; 2],
 }
 
 /// `DrawPush`: push constants of one scene draw.

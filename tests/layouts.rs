@@ -187,12 +187,13 @@ fn hisr_cut_header_matches_shared_glsl() {
 
 #[test]
 fn material_matches_shared_glsl() {
-    check!("gbuffer.frag", MaterialGpu, "MaterialGpu", pad2: 4, [
+    check!("gbuffer.frag", MaterialGpu, "MaterialGpu", pad0: 8, [
         base_color => "base_color",
-        texture => "texture",
+        texture_array => "texture_array",
+        texture_layer => "texture_layer",
+        texture_scale => "texture_scale",
+        texture_offset => "texture_offset",
         pad0 => "pad0",
-        pad1 => "pad1",
-        pad2 => "pad2",
     ]);
 }
 

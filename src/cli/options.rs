@@ -167,6 +167,8 @@ impl RunArgs {
                     || (self.camera.is_some() && w.contains("default camera")))
             });
         }
+        let shrunk = crate::frame::texture_arrays::warnings(&scene.textures);
+        scene.warnings.extend(shrunk);
         for w in &scene.warnings {
             eprintln!("warning: {w}");
         }

@@ -16,7 +16,6 @@ mod light_camera;
 pub mod limits;
 pub mod motion;
 pub mod obj_load;
-pub mod one_texture;
 pub mod text;
 mod texture_decode;
 mod uri;

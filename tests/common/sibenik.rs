@@ -7,15 +7,11 @@
 use glam::Vec3;
 use isr::scene::{Camera, Light, LightKind, Scene};
 
-/// The cathedral from the archive with the nave's camera and no light yet;
-/// one texture where the device cannot index texture arrays (`indexing`).
-pub fn nave(indexing: bool) -> anyhow::Result<Scene> {
+/// The cathedral from the archive with the nave's camera and no light yet.
+pub fn nave() -> anyhow::Result<Scene> {
     let path = isr::scene::description::archive_root().join("sibenik/sibenik.obj");
     let mut scene = isr::scene::load_file(&path, &Default::default())
         .map_err(|e| anyhow::anyhow!("{e:#}: {}", isr::scene::description::archive_hint()))?;
-    if !indexing {
-        isr::scene::one_texture::keep_one(&mut scene);
-    }
     scene.camera = Camera::look_at(
         Vec3::new(-17.0, -8.0, 0.0),
         Vec3::new(8.0, -4.0, 0.0),
