@@ -119,8 +119,7 @@ fn direct_light_matches_the_path_tracer_away_from_edges_for_every_light() {
 fn direct_light_in_the_sibenik_cathedral_matches_the_path_tracer_away_from_edges() {
     let gpu = gpu();
     let n = 256;
-    let mut scene = sibenik::nave()
-        .unwrap_or_else(|e| panic!("{e:#}"));
+    let mut scene = sibenik::nave().unwrap_or_else(|e| panic!("{e:#}"));
     for ((name, light), rsm) in sibenik::lights()
         .into_iter()
         .flat_map(|l| RSM_SIZES.map(|r| (l, r)))
