@@ -116,7 +116,9 @@ alone.\n\n",
         } else {
             md += &format!(
                 "; `isr` said:\n\n```\n{}\n```\n\n",
-                bare.placed.join("\n").replace(&obj, &format!("$ISR_SCENES/{file}"))
+                bare.placed
+                    .join("\n")
+                    .replace(&obj, &format!("$ISR_SCENES/{file}"))
             );
         }
     }

@@ -33,6 +33,10 @@ struct FrameUniforms {
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
     vec4 grid_cube;         // the voxel grid's cube around this frame's posed scene:
                             // xyz its min corner (m), w the side of a finest cell (m)
+    vec3 scene_min;         // the scene's bounds as loaded (m; relative to the render
+    float pad4;             // origin like every position): fixed for a run, so what
+    vec3 scene_max;         // is fitted to them does not change size as objects move
+    float pad5;
     mat4 shadow_view_proj;  // world -> shadow map clip (direct light's shadows, shadow.rs):
                             // the RSM's frustum for spot and point lights; a directional
                             // light's fitted to what the camera sees (docs/algorithm.md 2.2)

@@ -1,9 +1,12 @@
 //! How many bounces of indirect light a run computes (docs/algorithm.md
 //! section 5.4, "Bounces"): `--bounces N`, a count from 1 to 8, or `inf`
 //! for the whole series. A parameter of the run, not of one method: the
-//! path tracer reads it, and so the bench's truth (`bench::truth`); the GPU
-//! methods render one bounce and do not read it yet, so for them it is a
-//! parameter with no effect (the CLI warns of it as of any other).
+//! path tracer reads it, and so the bench's truth (`bench::truth`), and the
+//! GPU methods that `renders_bounces` (the gathering methods, the splats,
+//! the reference) add bounces 2..N through the shared bounce passes
+//! (`bounce`, docs/algorithm.md section 5.9); for the others (`none`,
+//! `lpv`) it is a parameter with no effect (the CLI warns of it as of any
+//! other).
 //!
 //! The path tracer keeps the light of bounces 1, 2, 3 and "4 and more" in
 //! separate layers ([`LAYERS`]), so that one trace gives every smaller N:
@@ -108,8 +111,9 @@ impl ParamType for Bounces {
 pub const BOUNCES: Param<Bounces> = Param {
     name: "bounces",
     help: "Bounces of indirect light: a count, or inf for every bounce (paths end by Russian \
-           roulette). --method pathtrace reads it, and the truth of isr bench; the GPU methods \
-           render one bounce and do not read it yet",
+           roulette). --method pathtrace reads it, the truth of isr bench, and every gathering \
+           method (bounces 2..N through the voxel grid's cells; inf: until a bounce adds under \
+           1%)",
     default: DefaultValue::Fixed(Bounces::ONE),
     range: Range::closed(1.0, MAX_COUNT as f64),
 };

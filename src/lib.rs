@@ -5,10 +5,12 @@
 //! Reading order: `renderer` (creates, records, submits), `frame` (what every
 //! pass shares), `passes` (one module per shared pass), `methods` (one module
 //! per indirect method, and their registry), `multires` (the eye-space
-//! framework), `voxel_grid` and `visibility`, `vk` (device, resources,
+//! framework), `voxel_grid` and `visibility`, `bounce` (bounces 2..N for every
+//! gathering method), `vk` (device, resources,
 //! barriers, pipelines, timing), `scene`. docs/architecture.md has the map.
 
 pub mod bench;
+pub mod bounce;
 pub mod bounces;
 pub mod cli;
 pub mod debug_view;
@@ -21,6 +23,7 @@ pub mod multires;
 pub mod output;
 pub mod passes;
 pub mod pathtrace;
+pub mod placement;
 pub mod progress;
 pub mod readback;
 pub mod regular_vpls;

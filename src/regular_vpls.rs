@@ -86,7 +86,7 @@ impl RegularVpls {
         Self::with_count(s, s.rsm_resolution * s.rsm_resolution)
     }
 
-    fn with_count(s: &RenderSettings, count: u32) -> Self {
+    pub fn with_count(s: &RenderSettings, count: u32) -> Self {
         let side = ((count as f64).sqrt() as u32).max(1);
         let level = s.rsm_resolution.max(side).ilog2() - side.ilog2();
         Self { count, side, level }

@@ -434,11 +434,14 @@ fn the_visibility_axis_renders_readers_without_and_with_the_grid() {
 /// `--bounces` (docs/algorithm.md section 6.6, "Bounces"), at 32x32 on the
 /// box: the truth is traced with every bounce and cached apart from the
 /// one-bounce truth; every row says its truth's bounces (results.json and
-/// .csv) and its key keeps it apart, and the report names them. The GPU
-/// methods render one bounce, and the box's first bounce is about half its
-/// indirect light (docs/algorithm.md section 5.4, "Bounces"): against every
-/// bounce the dense reference misses the other half, and is over twice as
-/// far from the truth as against one bounce (measured 0.144 and 0.375).
+/// .csv) and its key keeps it apart, and the report names them. `hisr` and
+/// the dense reference render every bounce too (docs/algorithm.md section
+/// 5.9), so the run warns of no method. The box's first bounce is about
+/// half its indirect light (section 5.4, "Bounces"): rendering one bounce
+/// the reference was 2.6x as far from the truth of every bounce as from the
+/// truth of one (0.375 and 0.144); rendering every bounce, 1.98x (0.285).
+/// 2.3x lies between the two: a reference that stopped rendering the later
+/// bounces would fail.
 #[test]
 fn bounces_trace_the_truth_with_as_many_and_every_row_says_which() {
     let dir = temp_dir("bench-bounces");
@@ -460,10 +463,7 @@ fn bounces_trace_the_truth_with_as_many_and_every_row_says_which() {
         r["truth"]["rel_rmse_indirect"].as_f64().unwrap()
     };
     let (stderr, every) = run(&["--bounces", "inf"]);
-    assert!(
-        stderr.contains("--bounces inf: the truth is traced with every bounce"),
-        "{stderr}"
-    );
+    assert!(!stderr.contains("render one bounce"), "{stderr}");
     let hisr = isr::bench::sweep::sweep(isr::methods::hisr::KEY, 32, true).len();
     assert_eq!(every.len(), 1 + hisr);
     for r in &every {
@@ -494,7 +494,7 @@ fn bounces_trace_the_truth_with_as_many_and_every_row_says_which() {
         "the dense reference against the truth: {e1:.4} (1 bounce), {e_every:.4} (every bounce)"
     );
     assert!(
-        e_every > 2.0 * e1,
+        e_every < 2.3 * e1,
         "{e1} against one bounce, {e_every} against every"
     );
     // Run again with every bounce: its rows and its truth are found.

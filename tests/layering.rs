@@ -18,10 +18,11 @@ const LAYERS: &[&[&str]] = &[
     &["visibility"],
     &["multires"],
     &["regular_vpls"],
+    &["bounce"],
     &["methods", "readback"],
     &["method_args", "debug_view", "output"],
     &["renderer", "pathtrace"],
-    &["report", "soak", "exact_visibility"],
+    &["report", "soak", "exact_visibility", "placement"],
     &["viewer", "bench"],
     &["cli"],
 ];

@@ -3,14 +3,16 @@
 //! bounces (`inf`: every bounce), and every row, table and chart that shows
 //! an error against the truth says which. The truth side of the axis, as
 //! `visibility` is for indirect visibility: how a run's bounces key its rows
-//! and its cached truth, and how they are labelled. The GPU methods render
-//! one bounce whatever `--bounces` says (they do not read it yet), so a row
-//! of N > 1 measures what the bounces they leave out cost too.
+//! and its cached truth, and how they are labelled. The methods that render
+//! bounces (`Descriptor::renders_bounces`: the gathering methods, the
+//! splats, the reference) render N of them through the shared bounce passes
+//! (`bounce`); the others (`none`, `lpv`) render one, so their rows of
+//! N > 1 measure what the bounces they leave out cost too.
 
 use super::rows::Row;
 use super::Plan;
 use crate::bounces::{Bounces, BOUNCES};
-use crate::settings::{ParamType as _, RenderSettings};
+use crate::settings::{Method, ParamType as _, RenderSettings};
 
 /// The bounces of rows rendered with `s`, as rows and tables show them:
 /// `1`, `3`, `inf` (what `--bounces` takes).
@@ -45,17 +47,27 @@ pub fn truth_words(bounces: Bounces) -> String {
     format!("path-traced truth of {}", bounces.words())
 }
 
-/// The run's warning when its truth has more bounces than the GPU methods
-/// render: they do not read `--bounces` yet.
-pub fn warning(s: &RenderSettings) -> Option<String> {
+/// The run's warning when its truth has more bounces than some of its
+/// `methods` render: those that do not render bounces (`none`, `lpv`).
+pub fn warning(s: &RenderSettings, methods: &[Method]) -> Option<String> {
     let b = BOUNCES.get(s);
-    (b != Bounces::ONE).then(|| {
+    let one: Vec<&str> = methods
+        .iter()
+        .filter_map(|&m| crate::methods::find(m).ok())
+        .filter(|d| !d.renders_bounces())
+        .map(|d| d.key().name())
+        .collect();
+    (b != Bounces::ONE && !one.is_empty()).then(|| {
         format!(
-            "warning: --bounces {}: the truth is traced with {}, but the GPU methods render one \
-             bounce (they do not read --bounces yet): their errors against the truth include \
-             the light of the bounces they leave out",
+            "warning: --bounces {}: the truth is traced with {}, but {} render{} one bounce: \
+             {} errors against the truth include the light of the bounces {} leave{} out",
             b.text(),
-            b.words()
+            b.words(),
+            one.join(", "),
+            if one.len() == 1 { "s" } else { "" },
+            if one.len() == 1 { "its" } else { "their" },
+            if one.len() == 1 { "it" } else { "they" },
+            if one.len() == 1 { "s" } else { "" },
         )
     })
 }
@@ -136,10 +148,13 @@ mod tests {
         assert_eq!(truth_file(3, Bounces::ONE), "frame-3.exr");
         assert_eq!(truth_file(3, Bounces::Count(2)), "frame-3-bounces-2.exr");
         assert_eq!(truth_file(0, Bounces::Infinite), "frame-0-bounces-inf.exr");
-        assert!(warning(&default.base).is_none());
-        let w = warning(&two.base).unwrap();
+        let (none, hisr) = (crate::methods::DIRECT_ONLY, crate::methods::SUBJECT);
+        assert!(warning(&default.base, &[none]).is_none());
+        // A method that renders bounces is not warned of; one that does not is.
+        assert!(warning(&two.base, &[hisr]).is_none());
+        let w = warning(&two.base, &[hisr, none]).unwrap();
         assert!(
-            w.contains("--bounces 2") && w.contains("render one bounce"),
+            w.contains("--bounces 2") && w.contains("none renders one bounce"),
             "{w}"
         );
     }

@@ -281,7 +281,7 @@ impl BenchArgs {
         }
         // The truth's bounces, refused out of range before any work.
         crate::bounces::BOUNCES.check(&base)?;
-        if let Some(w) = bounces::warning(&base).filter(|_| truth_noise > 0.0) {
+        if let Some(w) = bounces::warning(&base, &methods).filter(|_| truth_noise > 0.0) {
             eprintln!("{w}");
         }
         Ok(Plan {

@@ -67,7 +67,7 @@ pub fn markdown(plan: &Plan, o: &Outcome, ratios: &[Ratio], images: &str) -> Str
         "# isr bench\n\n`{}` on {}: device **{}**, driver {}. {}x{}, RSM {}, {} animation frames per scene \
 (1/fps apart), {} timing frames at the first; times are medians of GPU timestamps (docs/algorithm.md \
 section 6.2), errors means over frames against the dense reference of the same frame (section 6.1) \
-and against {} (section 6.6; the GPU methods render one bounce whatever `--bounces` says), flicker \
+and against {} (section 6.6; with `--bounces` the gathering methods render as many through the voxel grid's cells, section 5.9), flicker \
 over the sequence (section 6.3), FLIP on the tone-mapped final image (section 6.4). Indirect \
 visibility: {} (section 6.7; a row with it is held against the dense reference with it, and the one \
 truth of each frame).{}\n\n",

@@ -20,8 +20,8 @@ pub struct Row {
     #[serde(default)]
     pub visibility: String,
     /// The bounces of the truth its `truth` errors are against
-    /// (`bench::bounces`: `1`, `3`, `inf`; `--bounces`). The GPU methods
-    /// render one bounce whatever it is. Rows journalled before there was
+    /// (`bench::bounces`: `1`, `3`, `inf`; `--bounces`), as many as the
+    /// methods that render bounces render. Rows journalled before there was
     /// a choice were against one bounce.
     #[serde(default = "one_bounce")]
     pub bounces: String,

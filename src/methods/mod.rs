@@ -107,6 +107,14 @@ pub trait Descriptor: Sync {
         false
     }
 
+    /// Whether it takes bounces 2..N of `--bounces N` from the shared
+    /// bounce passes (`bounce`), which add them to the indirect light it
+    /// writes: every method that evaluates the patch formula (the
+    /// gathering methods, the splats and the reference) by default.
+    fn renders_bounces(&self) -> bool {
+        self.reads_visibility()
+    }
+
     /// Whether `--visibility exact` (the CPU limit) applies to it: the dense
     /// reference only.
     fn takes_exact_visibility(&self) -> bool {
@@ -247,11 +255,17 @@ pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyPar
     } else {
         &[]
     };
+    let bounces: &[&dyn AnyParam] = if d.renders_bounces() {
+        &[&crate::bounces::BOUNCES]
+    } else {
+        &[]
+    };
     let own = d.params().iter().flat_map(|g| g.iter().copied());
     multires
         .iter()
         .chain(regular)
         .chain(visibility)
+        .chain(bounces)
         .copied()
         .chain(own)
 }
@@ -267,7 +281,11 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
     // (the viewer may switch to a method that reads it), so it counts
     // whatever the method.
     let grid = voxel_grid::VoxelGrid::bytes(s, grid_contents(d, s));
-    multires + grid + d.memory(s)
+    let bounces = match renders_bounces(d, s) {
+        true => crate::bounce::memory(s),
+        false => 0,
+    };
+    multires + grid + bounces + d.memory(s)
 }
 
 /// What a run of `d` with `s` asks of the voxel grid: occupancy with
@@ -276,8 +294,14 @@ pub fn memory(d: &dyn Descriptor, s: &RenderSettings) -> u64 {
 pub fn grid_contents(d: &dyn Descriptor, s: &RenderSettings) -> voxel_grid::Contents {
     voxel_grid::Contents {
         occupancy: visibility::uses_voxels(s),
-        surface: d.reads_voxel_surface(s),
+        surface: d.reads_voxel_surface(s) || renders_bounces(d, s),
     }
+}
+
+/// Whether a run of `d` with `s` records the bounce passes (`bounce`): `d`
+/// takes them and `--bounces` asks for more than one.
+pub fn renders_bounces(d: &dyn Descriptor, s: &RenderSettings) -> bool {
+    d.renders_bounces() && crate::bounce::active(s)
 }
 
 /// Writes `d`'s fields of the run uniforms for `s`: its capabilities', then
@@ -292,10 +316,10 @@ pub fn write_uniforms(d: &dyn Descriptor, s: &RenderSettings, u: &mut RunUniform
     d.write_uniforms(s, u);
 }
 
-/// Parameters of a run that no method here reads yet but every command
-/// takes: `--bounces`, which the path tracer and the bench's truth read
-/// (`bounces`). Set for a method that does not read it, it is warned of as
-/// any parameter the method does not read (`unused_params`).
+/// Parameters of a run that every command takes: `--bounces`, which the
+/// path tracer, the bench's truth and the methods that `renders_bounces`
+/// read (`bounces`). Set for a method that does not read it, it is warned
+/// of as any parameter the method does not read (`unused_params`).
 pub const RUN_PARAMS: &[&dyn AnyParam] = &[&crate::bounces::BOUNCES];
 
 /// Every parameter of every method, once each, in registry order, then

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 impl Renderer<'_> {
     /// Records `slot`'s frame: the G-buffer, then for each light view its
-    /// RSM, direct light, light tree and method passes (summed by
+    /// RSM, direct light, light tree, method and bounce passes (summed by
     /// `light-sum` when there are several; the method's camera-only passes
     /// only in the first view), then the composite, tonemap and what
     /// `extension` adds (the viewer's presentation). A `counting` frame holds
@@ -114,6 +114,10 @@ impl Renderer<'_> {
                     begin(cmds[c])?;
                 }
                 method.record(&ctx(cmds[c], v), p, k);
+            }
+            // Bounces 2..N of this view's light, added to the method's.
+            if let Some(bounce) = &self.bounce {
+                bounce.record(&ctx(cmds[c], v), p);
             }
             if let Some(sum) = &self.light_sum {
                 if active.len() > 1 {

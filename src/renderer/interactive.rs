@@ -129,6 +129,7 @@ impl<'g> Renderer<'g> {
             grid_surface: self.voxel_grid.surface.as_ref(),
         };
         let method = crate::methods::create(&setup)?;
+        let bounce = super::make_bounce(&setup, descriptor)?;
         let passes = (MAX_PASSES + method.submissions() as u32) * self.views.len() as u32;
         for slot in &mut self.slots {
             slot.profiler = Profiler::new(gpu, passes)?;
@@ -150,6 +151,7 @@ impl<'g> Renderer<'g> {
             );
         })?;
         self.method = method;
+        self.bounce = bounce;
         self.grid_in_use = grid_in_use;
         self.run_uniforms.1 = values;
         self.settings = settings.clone();

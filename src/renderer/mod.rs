@@ -10,6 +10,7 @@
 //! between frames (camera, light, instance transforms) is data in the frame
 //! set of the frame's slot, written just before it is submitted.
 
+use crate::bounce::BouncePass;
 use crate::frame::check::{
     check_light_views, check_ranges, check_settings, check_textures, AddedMemory,
 };
@@ -91,6 +92,9 @@ pub struct Renderer<'g> {
     /// Pass `voxel-surface`, made when the method reads the surface in the
     /// grid's cells (`Descriptor::reads_voxel_surface`).
     surface_pass: Option<SurfacePass>,
+    /// The bounce passes (`bounce`), made when the method renders bounces
+    /// and `--bounces` asks for more than one.
+    bounce: Option<BouncePass>,
     /// Point lights' layered cube RSM (made only when the scene has one).
     rsm_cube: Option<CubeRsmPass>,
     method: Box<dyn IndirectMethod>,
@@ -210,6 +214,7 @@ impl<'g> Renderer<'g> {
             Some(surface) => Some(SurfacePass::new(&setup, surface)?),
             None => None,
         };
+        let bounce = make_bounce(&setup, descriptor)?;
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
@@ -236,6 +241,7 @@ impl<'g> Renderer<'g> {
             visibility_pass,
             grid_in_use,
             surface_pass,
+            bounce,
             rsm_cube,
             method,
             rsm,
@@ -408,6 +414,18 @@ fn check_run(
         },
     )?;
     Ok(d)
+}
+
+/// The bounce passes of a run of `d` made from `setup` (`None` where it
+/// renders one bounce).
+fn make_bounce(setup: &Setup, d: &dyn Descriptor) -> Result<Option<BouncePass>> {
+    match (
+        crate::methods::renders_bounces(d, setup.settings),
+        setup.grid_surface,
+    ) {
+        (true, Some(surface)) => BouncePass::new(setup, surface),
+        _ => Ok(None),
+    }
 }
 
 /// Whether a run of `d` with `s` reads the voxel visibility grid.

@@ -16,10 +16,12 @@
 
 pub mod cli;
 pub mod court;
+pub mod framing;
 pub mod gltf;
 pub mod grid;
 pub mod measure;
 pub mod sibenik;
+pub mod sphere;
 
 // Every test binary compiles this kit; most use no grid helper.
 #[allow(unused_imports)]

@@ -1,0 +1,272 @@
+//! The bounce passes (`bounce-cells`, `bounce-transfer`, `bounce-propagate`,
+//! `bounce-gather`, `bounce-add`; docs/algorithm.md section 5.9) and their
+//! buffers. Barriers: each pass waits for the previous one's storage writes
+//! (`compute_to_compute`); the first waits for the previous frame's last
+//! readers of the buffers it writes and for the RSM quadtree and G-buffer
+//! (finished pass outputs, readable by the convention); `bounce-add` takes
+//! `indirect` from its resting state to storage and back.
+
+use super::{propagations, CELLS, CELL_BYTES, STEP, VPLS};
+use crate::bounces::{Bounces, BOUNCES};
+use crate::frame::{FrameContext, Setup};
+use crate::passes::INDIRECT_COMPUTE;
+use crate::regular_vpls::RegularVpls;
+use crate::visibility;
+use crate::vk::barrier::{self, Use};
+use crate::vk::pipeline::{Binding, DescriptorSet, Pipeline, Spec};
+use crate::vk::profiler::Profiler;
+use crate::vk::{Buffer, Gpu};
+use anyhow::{Context as _, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// One compute pipeline and its sets (set 1), one per variant.
+struct Stage {
+    pipeline: Pipeline,
+    sets: Vec<DescriptorSet>,
+}
+
+impl Stage {
+    fn new(
+        setup: &Setup,
+        name: &str,
+        shader: &str,
+        variants: &[Vec<Binding>],
+        specialization: &[Spec],
+    ) -> Result<Self> {
+        let sets = variants
+            .iter()
+            .map(|b| DescriptorSet::new(setup.gpu, name, b))
+            .collect::<Result<Vec<_>>>()?;
+        let pipeline = Pipeline::compute(
+            setup.gpu,
+            name,
+            shader,
+            &[setup.frame, &sets[0]],
+            0,
+            specialization,
+        )?;
+        Ok(Self { pipeline, sets })
+    }
+
+    fn dispatch(&self, ctx: &FrameContext, variant: usize, groups: (u32, u32)) {
+        self.pipeline.bind(
+            ctx.gpu,
+            ctx.cmd,
+            vk::PipelineBindPoint::COMPUTE,
+            &[ctx.frame_set, self.sets[variant].set],
+        );
+        unsafe { ctx.gpu.device.cmd_dispatch(ctx.cmd, groups.0, groups.1, 1) };
+    }
+}
+
+/// The bounce passes of a run with `--bounces` above 1.
+pub struct BouncePass {
+    cells: Stage,
+    transfer: Stage,
+    propagate: Stage,
+    gather: Stage,
+    add: Stage,
+    propagations: u32,
+    /// The receivers' grid: pixels / STEP, rounded up.
+    low: (u32, u32),
+    extent: (u32, u32),
+    /// `done` of `bounce-propagate`, cleared every frame.
+    state: Buffer,
+    /// Every buffer the passes write, for the barrier before the first.
+    _buffers: Vec<Buffer>,
+}
+
+fn storage(gpu: &Gpu, name: &str, bytes: u64) -> Result<Buffer> {
+    Buffer::new(
+        gpu,
+        name,
+        bytes,
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuOnly,
+    )
+    .with_context(|| format!("the bounce passes' {name}"))
+}
+
+impl BouncePass {
+    /// The passes of `setup`'s run over the grid's surface sums `surface`;
+    /// `None` with one bounce.
+    pub fn new(setup: &Setup, surface: &Buffer) -> Result<Option<Self>> {
+        let Some(propagations) = propagations(setup.settings) else {
+            return Ok(None);
+        };
+        let (gpu, s, t) = (setup.gpu, setup.settings, setup.targets);
+        let cells_n = CELLS as u64;
+        let cells = storage(gpu, "cells", cells_n * CELL_BYTES)?;
+        let power_a = storage(gpu, "power", cells_n * 16)?;
+        let power_b = storage(gpu, "power (next)", cells_n * 16)?;
+        let power_sum = storage(gpu, "power summed", cells_n * 16)?;
+        let transfer = storage(gpu, "transfer", cells_n * cells_n * 4)?;
+        let low = (s.width.div_ceil(STEP), s.height.div_ceil(STEP));
+        let received = storage(gpu, "receivers", low.0 as u64 * low.1 as u64 * 16)?;
+        let state = storage(gpu, "state", 16)?;
+        // Every shader includes bounce/bounce.glsl, which declares it.
+        let step = Spec::int("BOUNCE_STEP", STEP as i32);
+        let vis = [&visibility::specialization(s)[..], &[step]].concat();
+        let r = s.rsm_resolution as u64;
+        let count = (VPLS as u64).min(r * r) as u32;
+        let vpls = RegularVpls::with_count(s, count).specialization(s);
+        let nearest = setup.samplers.nearest;
+        let cells_pass = Stage::new(
+            setup,
+            "bounce-cells",
+            "bounce/cells.comp",
+            &[vec![
+                Binding::storage("GridSurface", surface),
+                Binding::storage("BounceCells", &cells),
+                Binding::storage("BouncePower", &power_a),
+                Binding::storage("BouncePowerSum", &power_sum),
+                Binding::sampled("rsm_position", t.rsm_position.view, nearest),
+                Binding::sampled("rsm_normal", t.rsm_normal.view, nearest),
+                Binding::sampled("rsm_flux", t.rsm_flux.view, nearest),
+            ]],
+            &[&vis[..], &vpls[..]].concat(),
+        )?;
+        let transfer_pass = Stage::new(
+            setup,
+            "bounce-transfer",
+            "bounce/transfer.comp",
+            &[vec![
+                Binding::storage("BounceCells", &cells),
+                Binding::storage("BounceTransfer", &transfer),
+            ]],
+            &vis,
+        )?;
+        let ping_pong = |from, to| {
+            vec![
+                Binding::storage("BounceCells", &cells),
+                Binding::storage("BounceTransfer", &transfer),
+                Binding::storage("PowerIn", from),
+                Binding::storage("PowerOut", to),
+                Binding::storage("BouncePowerSum", &power_sum),
+                Binding::storage("BounceState", &state),
+            ]
+        };
+        let propagate = Stage::new(
+            setup,
+            "bounce-propagate",
+            "bounce/propagate.comp",
+            &[ping_pong(&power_a, &power_b), ping_pong(&power_b, &power_a)],
+            &[
+                step,
+                Spec::bool("BOUNCE_INFINITE", BOUNCES.get(s) == Bounces::Infinite),
+            ],
+        )?;
+        let gbuffer = |b: &mut Vec<Binding>| {
+            b.push(Binding::sampled(
+                "gbuffer_position",
+                t.gbuffer_position.view,
+                nearest,
+            ));
+            b.push(Binding::sampled(
+                "gbuffer_normal",
+                t.gbuffer_normal.view,
+                nearest,
+            ));
+        };
+        let mut gather_bindings = vec![];
+        gbuffer(&mut gather_bindings);
+        gather_bindings.extend([
+            Binding::storage("BounceCells", &cells),
+            Binding::storage("BouncePowerSum", &power_sum),
+            Binding::storage("BounceReceived", &received),
+        ]);
+        let gather = Stage::new(
+            setup,
+            "bounce-gather",
+            "bounce/gather.comp",
+            &[gather_bindings],
+            &vis,
+        )?;
+        let mut add_bindings = vec![];
+        gbuffer(&mut add_bindings);
+        add_bindings.extend([
+            Binding::storage("BounceReceived", &received),
+            Binding::storage_image("indirect", t.indirect.view),
+        ]);
+        let add = Stage::new(
+            setup,
+            "bounce-add",
+            "bounce/add.comp",
+            &[add_bindings],
+            &[step],
+        )?;
+        Ok(Some(Self {
+            cells: cells_pass,
+            transfer: transfer_pass,
+            propagate,
+            gather,
+            add,
+            propagations,
+            low,
+            extent: (s.width, s.height),
+            state,
+            _buffers: vec![cells, power_a, power_b, power_sum, transfer, received],
+        }))
+    }
+
+    /// Records the passes of one light view, after the method's: they add
+    /// bounces 2..N of this view's light to `indirect`.
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        profiler.pass(gpu, cmd, "bounce-cells", INDIRECT_COMPUTE, || {
+            // The previous view's or frame's readers of every buffer before
+            // they are written again.
+            barrier::memory(gpu, cmd, compute, rw, compute, rw);
+            self.cells.dispatch(ctx, 0, (CELLS, 1));
+            barrier::compute_to_compute(gpu, cmd);
+        });
+        // Two bounces reach receivers from the cells' first: no transfer.
+        if self.propagations > 0 {
+            self.record_propagation(ctx, profiler);
+        }
+        profiler.pass(gpu, cmd, "bounce-gather", INDIRECT_COMPUTE, || {
+            self.gather
+                .dispatch(ctx, 0, (self.low.0.div_ceil(8), self.low.1.div_ceil(8)));
+            barrier::compute_to_compute(gpu, cmd);
+        });
+        profiler.pass(gpu, cmd, "bounce-add", INDIRECT_COMPUTE, || {
+            let indirect = &ctx.targets.indirect;
+            barrier::transition(gpu, cmd, &[indirect], Use::READ_ONLY, Use::COMPUTE_STORAGE);
+            self.add.dispatch(
+                ctx,
+                0,
+                (self.extent.0.div_ceil(8), self.extent.1.div_ceil(8)),
+            );
+            barrier::transition(gpu, cmd, &[indirect], Use::COMPUTE_STORAGE, Use::READ_ONLY);
+        });
+    }
+
+    /// `bounce-transfer`, then bounces 3..N among the cells.
+    fn record_propagation(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+        let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+        let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        profiler.pass(gpu, cmd, "bounce-transfer", INDIRECT_COMPUTE, || {
+            self.transfer.dispatch(ctx, 0, (CELLS / 8, CELLS / 8));
+            barrier::compute_to_compute(gpu, cmd);
+        });
+        profiler.pass(gpu, cmd, "bounce-propagate", INDIRECT_COMPUTE, || {
+            // `done` starts clear, after the previous view's last reader.
+            barrier::zero_buffer(
+                gpu,
+                cmd,
+                self.state.buffer,
+                vk::WHOLE_SIZE,
+                (compute, rw),
+                (compute, rw),
+            );
+            for k in 0..self.propagations {
+                self.propagate.dispatch(ctx, (k % 2) as usize, (1, 1));
+                barrier::compute_to_compute(gpu, cmd);
+            }
+        });
+    }
+}
