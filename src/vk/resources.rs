@@ -22,6 +22,8 @@ pub struct Image {
     /// Extent of mip 0.
     pub extent: vk::Extent2D,
     pub layers: u32,
+    /// Texels along z of mip 0: 1, or the depth of a volume (`Image::volume`).
+    pub depth: u32,
     pub mips: u32,
     pub aspect: vk::ImageAspectFlags,
     allocation: Option<Allocation>,
@@ -87,14 +89,31 @@ pub fn texel_bytes(format: vk::Format) -> u64 {
 
 impl Image {
     pub fn new(gpu: &Gpu, desc: &ImageDesc) -> Result<Self> {
+        Self::create(gpu, desc, 1)
+    }
+
+    /// A 3D image of `depth` texels along z (`desc.layers` must be 1), its
+    /// views 3D, so that samplers filter across z too (trilinear, and
+    /// between mips).
+    pub fn volume(gpu: &Gpu, desc: &ImageDesc, depth: u32) -> Result<Self> {
+        anyhow::ensure!(desc.layers == 1, "volume {} has one layer", desc.name);
+        Self::create(gpu, desc, depth)
+    }
+
+    fn create(gpu: &Gpu, desc: &ImageDesc, depth: u32) -> Result<Self> {
         let aspect = aspect_of(desc.format);
+        let volume = depth > 1;
         let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
+            .image_type(if volume {
+                vk::ImageType::TYPE_3D
+            } else {
+                vk::ImageType::TYPE_2D
+            })
             .format(desc.format)
             .extent(vk::Extent3D {
                 width: desc.extent.width,
                 height: desc.extent.height,
-                depth: 1,
+                depth,
             })
             .mip_levels(desc.mips)
             .array_layers(desc.layers)
@@ -112,6 +131,7 @@ impl Image {
             format: desc.format,
             extent: desc.extent,
             layers: desc.layers,
+            depth,
             mips: desc.mips,
             aspect,
             allocation: None,
@@ -137,14 +157,16 @@ impl Image {
                     desc.name,
                     desc.extent.width,
                     desc.extent.height,
-                    desc.layers
+                    desc.layers * depth
                 )
             })?;
         // SAFETY: the memory is bound to this object only, and freed after it.
         let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
         out.allocation = Some(allocation);
         unsafe { gpu.device.bind_image_memory(image, memory, offset)? };
-        let view_type = if desc.layers > 1 {
+        let view_type = if volume {
+            vk::ImageViewType::TYPE_3D
+        } else if desc.layers > 1 {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D
