@@ -48,6 +48,7 @@ fn inside_a_closed_sphere_the_first_bounce_is_near_uniform() {
         let off = mean / expected - 1.0;
         println!("{group} ({n} px): E = {mean:.5}, expected {expected:.5}: off by {off:+.3}");
         assert!(n > 300, "{group}: {n} pixels");
+        assert!(off.is_finite(), "{group}: {mean}");
         worst = worst.max(off.abs());
     }
     // The cones see the wall through its cells, whose radiance is the

@@ -1,23 +1,31 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Method vct, pass vct-mips (docs/algorithm.md section 9.2), one dispatch
-// per level, one invocation per cell of the level.
+// per level, one invocation per cell of the level. Three volumes:
+// radiance (premultiplied colour, opacity), the lit surface's lobe and the
+// surface's lobe.
 //
 // Level 0, from a cell's injection sums and the surface inside it (the
-// voxel grid's `voxel-surface` sums, area A_s in cell faces):
+// voxel grid's `voxel-surface` sums: area A_s in cell faces, normal sum):
 //   A     = max(A_s, A_rsm)          (the RSM may see surface the grid's
 //                                      samples missed)
 //   alpha = min(1, A)                (a cell face of surface blocks the cell)
 //   L     = Phi / (pi A h^2)         (the outgoing radiance of the surface in
 //                                      it, W/(m^2 sr): all of its area shares
 //                                      the flux, lit or not)
-// stored premultiplied: (L alpha, alpha). The lobe: the lit surface's mean
+// radiance (L alpha, alpha); lit lobe (m w, w): the lit surface's mean
 // normal m = sum(n Phi) / sum(Phi) (its length falls where normals
-// disagree) times the premultiplied luminance w = mean(L alpha): (m w, w).
+// disagree) times w = mean(L alpha); surface lobe (s alpha, alpha): the
+// surface's mean normal s = sum(n A) / A.
 //
-// Level k + 1: the mean of the 8 cells under it, for both volumes (colour
-// premultiplied, so an empty child lowers opacity and colour together and
-// the parent's colour per opacity is its children's opacity-weighted mean).
+// Level k + 1 from the 8 cells under it. Opacity is composited, not
+// averaged: along each axis the two cells of each of the 4 columns in
+// turn, 1 - (1 - a_front)(1 - a_back), averaged over the columns, and the
+// largest of the three axes kept. A wall one cell thick stays opaque at
+// every level seen across it, where the mean would make it 2^-k opaque
+// and let cones run out of the grid before they gather its light
+// (docs/experiments.md). Colour keeps the children's opacity-weighted mean
+// radiance: c = mean(c_i) / mean(a_i) * alpha. The lobes are means.
 #include "frame.glsl"
 #include "vct/vct.glsl"
 #include "voxel_grid/surface.glsl"
@@ -27,8 +35,10 @@ layout(set = 1, binding = 0, std430) readonly buffer GridSurface { uint surface[
 layout(set = 1, binding = 1, std430) readonly buffer VctAccum { uint accum[]; };
 layout(set = 1, binding = 2, rgba32f) uniform readonly image3D source_radiance;
 layout(set = 1, binding = 3, rgba32f) uniform readonly image3D source_lobe;
-layout(set = 1, binding = 4, rgba32f) uniform writeonly image3D target_radiance;
-layout(set = 1, binding = 5, rgba32f) uniform writeonly image3D target_lobe;
+layout(set = 1, binding = 4, rgba32f) uniform readonly image3D source_surface;
+layout(set = 1, binding = 5, rgba32f) uniform writeonly image3D target_radiance;
+layout(set = 1, binding = 6, rgba32f) uniform writeonly image3D target_lobe;
+layout(set = 1, binding = 7, rgba32f) uniform writeonly image3D target_surface;
 layout(push_constant) uniform Push { int level; };
 
 void main() {
@@ -38,12 +48,13 @@ void main() {
     if (c.x >= m || c.z >= m) {
         return;
     }
-    vec4 radiance = vec4(0.0), lobe = vec4(0.0);
+    vec4 radiance = vec4(0.0), lobe = vec4(0.0), facing = vec4(0.0);
     if (level == 0) {
         int i = vct_cell_index(c);
         uint base = uint(i) * ACCUM_WORDS;
-        float area = max(float(surface[uint(i) * SURFACE_WORDS]) / SURFACE_ONE,
-                         float(accum[base + 3u]) / AREA_ONE);
+        uint s = uint(i) * SURFACE_WORDS;
+        float a_s = float(surface[s]) / SURFACE_ONE;
+        float area = max(a_s, float(accum[base + 3u]) / AREA_ONE);
         if (area > 0.0) {
             float unit = vct_flux_unit();
             vec3 flux = vec3(accum[base], accum[base + 1u], accum[base + 2u]) * unit;
@@ -56,16 +67,40 @@ void main() {
             vec3 mean = lum > 0.0 ? n / lum : vec3(0.0);
             float w = (radiance.r + radiance.g + radiance.b) / 3.0;
             lobe = vec4(mean * w, w);
+            vec3 ns = vec3(ivec3(surface[s + 4u], surface[s + 5u], surface[s + 6u])) / SURFACE_ONE;
+            facing = vec4((a_s > 0.0 ? ns / a_s : vec3(0.0)) * alpha, alpha);
         }
     } else {
+        float a[8];
+        float mean_a = 0.0;
+        vec3 mean_c = vec3(0.0);
         for (int j = 0; j < 8; ++j) {
             ivec3 child = 2 * c + ivec3(j & 1, (j >> 1) & 1, j >> 2);
-            radiance += imageLoad(source_radiance, child);
+            vec4 r = imageLoad(source_radiance, child);
+            a[j] = r.a;
+            mean_a += r.a;
+            mean_c += r.rgb;
             lobe += imageLoad(source_lobe, child);
+            facing += imageLoad(source_surface, child);
         }
-        radiance *= 0.125;
+        mean_a *= 0.125;
+        mean_c *= 0.125;
         lobe *= 0.125;
+        facing *= 0.125;
+        float alpha = 0.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            int bit = 1 << axis;
+            float columns = 0.0;
+            for (int j = 0; j < 8; ++j) {
+                if ((j & bit) == 0) {
+                    columns += 1.0 - (1.0 - a[j]) * (1.0 - a[j | bit]);
+                }
+            }
+            alpha = max(alpha, 0.25 * columns);
+        }
+        radiance = vec4(mean_a > 0.0 ? mean_c * (alpha / mean_a) : vec3(0.0), alpha);
     }
     imageStore(target_radiance, c, radiance);
     imageStore(target_lobe, c, lobe);
+    imageStore(target_surface, c, facing);
 }

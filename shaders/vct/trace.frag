@@ -11,11 +11,16 @@
 //   a' = 1 - (1 - a)^(step / cell),  L += (1 - alpha) c a' / a,
 //   alpha += (1 - alpha) a'
 // (c, a the premultiplied colour and opacity read; a' the opacity of the
-// step's length), until alpha reaches 0.95 or the cone leaves the grid.
-// With VCT_LOBE a cell's light goes only to the side its lit surface
-// faces: c is scaled by (1 - |m|) + |m| clamp(1/2 - 2 d.m^, 0, 1), m the
-// cell's mean normal (vct/mips.comp), so a surface lights nothing behind it
-// nor itself.
+// step's length), until alpha reaches 0.95 or the cone is a diameter past
+// the grid.
+// With VCT_LOBE cells are one-sided: a cell's light goes only to the side
+// its lit surface faces, c scaled by the facing term
+//   f(m) = (1 - |m|) + |m| clamp(1/2 - 2 d.m^, 0, 1),
+// m the lit surface's mean normal (vct/mips.comp), and a cell blocks only
+// cones that meet its surface's front, c and a scaled by f(s), s the
+// surface's mean normal (a wall with both faces in one cell has |s| = 0
+// and blocks both ways). So a surface neither lights nor shadows itself:
+// the cone leaving a floor passes the floor's own coarse cells.
 #include "frame.glsl"
 #include "vct/vct.glsl"
 
@@ -28,6 +33,7 @@ layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 1, binding = 2) uniform sampler3D vct_radiance;  // rgb: L alpha; a: alpha
 layout(set = 1, binding = 3) uniform sampler3D vct_lobe;      // xyz: m w; w: w
+layout(set = 1, binding = 4) uniform sampler3D vct_surface;   // xyz: s alpha; w: alpha
 
 layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2)
 
@@ -35,6 +41,23 @@ layout(location = 0) out vec4 out_irradiance;  // rgb: E (W/m^2)
 const float STEP = 0.5;
 const float OPAQUE = 0.95;
 const float CAP_TAN = 0.57735026919;  // tan 30 degrees
+
+// The facing term of a lobe (xyz: a mean normal times w; w) for a cone
+// going along `dir`: 1 where the normal faces the cone's apex, 0 where it
+// faces away, 1 where normals disagree.
+float facing(vec4 lobe, vec3 dir) {
+    // Trilinear tails leave denormal weights, which a division may flush.
+    if (!(lobe.w > 1e-20)) {
+        return 1.0;
+    }
+    vec3 m = lobe.xyz / lobe.w;
+    float len = length(m);
+    if (!(len > 1e-4)) {
+        return 1.0;
+    }
+    float k = min(len, 1.0);
+    return (1.0 - k) + k * clamp(0.5 - 2.0 * dot(dir, m) / len, 0.0, 1.0);
+}
 
 // The radiance arriving along the cone from `origin` in direction `dir`.
 vec3 cone(vec3 origin, vec3 dir, float tan_half) {
@@ -50,9 +73,15 @@ vec3 cone(vec3 origin, vec3 dir, float tan_half) {
         float d = max(h, 2.0 * t * tan_half);
         float lod = min(log2(d / h), top);
         vec3 uvw = (origin + t * dir - u.grid_cube.xyz) / side;
-        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
+        // Past the grid by more than the cone's width, nothing is left to
+        // read; within a width of it the cone still covers the cells on
+        // the edge (a wall on the scene's bounds, which the last step
+        // inside may only graze), so it reads them there.
+        float out_by = max(max(-min(uvw.x, min(uvw.y, uvw.z)), max(uvw.x, max(uvw.y, uvw.z)) - 1.0), 0.0);
+        if (out_by * side > d) {
             break;
         }
+        uvw = clamp(uvw, vec3(0.0), vec3(1.0));
         vec4 s = textureLod(vct_radiance, uvw, lod);
         float step = STEP * d;
         float a = clamp(s.a, 0.0, 1.0);
@@ -60,11 +89,9 @@ vec3 cone(vec3 origin, vec3 dir, float tan_half) {
         float a_step = 1.0 - pow(1.0 - a, ratio);
         vec3 colour = s.rgb * (a > 1e-6 ? a_step / a : ratio);
         if (VCT_LOBE) {
-            vec4 l = textureLod(vct_lobe, uvw, lod);
-            vec3 m = l.w > 0.0 ? l.xyz / l.w : vec3(0.0);
-            float k = min(length(m), 1.0);
-            float facing = k > 1e-4 ? clamp(0.5 - 2.0 * dot(dir, m) / length(m), 0.0, 1.0) : 1.0;
-            colour *= (1.0 - k) + k * facing;
+            float front = facing(textureLod(vct_surface, uvw, lod), dir);
+            colour *= front * facing(textureLod(vct_lobe, uvw, lod), dir);
+            a_step *= front;
         }
         c += (1.0 - alpha) * colour;
         alpha += (1.0 - alpha) * a_step;

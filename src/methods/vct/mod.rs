@@ -42,8 +42,8 @@ pub const LOBE: Param<bool> = Param {
     range: Range::ANY,
 };
 
-/// The grid side VCT takes at most: 128^3 cells of two RGBA32F volumes and
-/// their mips are 77 MiB; 256^3 would be 610 MiB.
+/// The grid side VCT takes at most: 128^3 cells of three RGBA32F volumes
+/// and their mips, and the sums, are 177 MiB; 256^3 would be 1.4 GiB.
 pub const MAX_SIDE: u32 = 128;
 
 /// Its own parameters, and the grid's side (`--visibility-grid`), which it
@@ -77,12 +77,13 @@ impl Layout {
         (self.side as u64).pow(3)
     }
 
-    /// Bytes of GPU memory: the injection sums (8 words a cell) and two
-    /// RGBA32F volumes (radiance and opacity; the emission lobe) with their
-    /// mips (each level an eighth of the one below: at most 8/7 of the finest).
+    /// Bytes of GPU memory: the injection sums (8 words a cell) and three
+    /// RGBA32F volumes (radiance and opacity; the lit surface's lobe; the
+    /// surface's lobe) with their mips (each level an eighth of the one
+    /// below: at most 8/7 of the finest).
     pub fn bytes(&self) -> u64 {
         let mips: u64 = (0..self.levels).map(|k| (self.side as u64 >> k).pow(3)).sum();
-        self.cells() * volume::ACCUM_WORDS as u64 * 4 + 2 * 16 * mips
+        self.cells() * volume::ACCUM_WORDS as u64 * 4 + 3 * 16 * mips
     }
 }
 
@@ -164,10 +165,10 @@ mod tests {
         let s = RenderSettings::DEFAULT.with_method(KEY);
         let l = Layout::of(&s);
         assert_eq!((l.side, l.levels, l.cones, l.lobe), (64, 7, 6, true));
-        // 64^3 cells of 32 bytes, and two volumes of 16 bytes a texel over
+        // 64^3 cells of 32 bytes, and three volumes of 16 bytes a texel over
         // 64^3 + 32^3 + ... + 1 texels.
         let mips: u64 = [64u64, 32, 16, 8, 4, 2, 1].iter().map(|n| n * n * n).sum();
-        assert_eq!(l.bytes(), 262_144 * 32 + 32 * mips);
+        assert_eq!(l.bytes(), 262_144 * 32 + 48 * mips);
         assert!(VctMethod.check(&s).is_ok());
         assert!(VctMethod
             .check(&s.clone().with(&voxel_grid::GRID, 256))

@@ -6,9 +6,10 @@
 //!   atomics (fixed point: the sums do not depend on the order texels come
 //!   in, so the volume is the same every run).
 //! - `vct-mips`: `vct/mips.comp`, one dispatch per level: level 0 turns each
-//!   cell's sums and the surface area in it (`voxel-surface`) into
-//!   premultiplied radiance and opacity, and its emission lobe; each further
-//!   level is the mean of the 8 cells under it.
+//!   cell's sums and the surface in it (`voxel-surface`) into premultiplied
+//!   radiance and opacity and two lobes (which way its lit surface and its
+//!   surface face); each further level composites the opacity of the 8
+//!   cells under it along each axis and keeps the others' means.
 //! - `vct-trace`: `fullscreen.vert` + `vct/trace.frag` trace the cones
 //!   through the volumes (hardware trilinear between cells and mips) and
 //!   write `indirect`.
@@ -45,6 +46,9 @@ pub struct Vct {
     /// The emission lobe: the mean normal of the lit surface times the
     /// luminance of `radiance` (xyz), and that luminance (w), every level.
     lobe: Image,
+    /// The surface's lobe: its mean normal times opacity (xyz), and
+    /// opacity (w), every level.
+    surface: Image,
     _sampler: Sampler,
     rsm_texels: u32,
     inject: ComputePass,
@@ -94,6 +98,7 @@ impl Vct {
         };
         let radiance = volume("vct radiance")?;
         let lobe = volume("vct lobe")?;
+        let surface_lobe = volume("vct surface lobe")?;
         let accum = Buffer::new(
             gpu,
             "vct injection sums",
@@ -139,8 +144,10 @@ impl Vct {
                 Binding::storage("VctAccum", &accum),
                 Binding::storage_image("source_radiance", radiance.mip_views[from]),
                 Binding::storage_image("source_lobe", lobe.mip_views[from]),
+                Binding::storage_image("source_surface", surface_lobe.mip_views[from]),
                 Binding::storage_image("target_radiance", radiance.mip_views[k]),
                 Binding::storage_image("target_lobe", lobe.mip_views[k]),
+                Binding::storage_image("target_surface", surface_lobe.mip_views[k]),
             ]
         };
         let variants: Vec<Vec<Binding>> = (0..layout.levels as usize).map(level).collect();
@@ -167,6 +174,7 @@ impl Vct {
                 Binding::sampled("gbuffer_normal", t.gbuffer_normal.view, nearest),
                 Binding::sampled("vct_radiance", radiance.view, sampler.sampler),
                 Binding::sampled("vct_lobe", lobe.view, sampler.sampler),
+                Binding::sampled("vct_surface", surface_lobe.view, sampler.sampler),
             ],
             0,
             |t| &t.indirect,
@@ -176,6 +184,7 @@ impl Vct {
             accum,
             radiance,
             lobe,
+            surface: surface_lobe,
             _sampler: sampler,
             rsm_texels: s.rsm_resolution,
             inject,
@@ -193,10 +202,10 @@ impl Vct {
         &self.accum
     }
 
-    /// The radiance and opacity volume of the last light view, and its lobe
-    /// (read-only between frames).
-    pub fn volumes(&self) -> [&Image; 2] {
-        [&self.radiance, &self.lobe]
+    /// The radiance and opacity volume of the last light view, its lit
+    /// lobe and its surface lobe (read-only between frames).
+    pub fn volumes(&self) -> [&Image; 3] {
+        [&self.radiance, &self.lobe, &self.surface]
     }
 }
 
@@ -233,7 +242,7 @@ impl IndirectMethod for Vct {
             // The atomics before level 0 reads the sums.
             barrier::compute_to_compute(gpu, cmd);
         });
-        let volumes = [&self.radiance, &self.lobe];
+        let volumes = self.volumes();
         profiler.pass(gpu, cmd, "vct-mips", INDIRECT_COMPUTE, || {
             // Discard: the previous view's trace (and readbacks) are done first.
             barrier::transition(
