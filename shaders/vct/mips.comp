@@ -7,8 +7,13 @@
 //
 // Level 0, from a cell's injection sums and the surface inside it (the
 // voxel grid's `voxel-surface` sums: area A_s in cell faces, normal sum):
-//   A     = max(A_s, A_rsm)          (the RSM may see surface the grid's
-//                                      samples missed)
+//   A     = A_s, or A_rsm where the grid's samples missed the surface the
+//           RSM saw (A_s = 0). Not the larger: an RSM texel wider than a
+//           cell puts all its flux (and area) in the one cell holding its
+//           centre, and spreading that flux over the texel's area there
+//           would lose the rest of it (9x in the box at R = 64, 64^3).
+//           The cell emits exactly the flux it holds, L alpha pi h^2 = Phi
+//           for A >= 1.
 //   alpha = min(1, A)                (a cell face of surface blocks the cell)
 //   L     = Phi / (pi A h^2)         (the outgoing radiance of the surface in
 //                                      it, W/(m^2 sr): all of its area shares
@@ -54,7 +59,7 @@ void main() {
         uint base = uint(i) * ACCUM_WORDS;
         uint s = uint(i) * SURFACE_WORDS;
         float a_s = float(surface[s]) / SURFACE_ONE;
-        float area = max(a_s, float(accum[base + 3u]) / AREA_ONE);
+        float area = a_s > 0.0 ? a_s : float(accum[base + 3u]) / AREA_ONE;
         if (area > 0.0) {
             float unit = vct_flux_unit();
             vec3 flux = vec3(accum[base], accum[base + 1u], accum[base + 2u]) * unit;

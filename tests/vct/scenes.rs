@@ -122,4 +122,3 @@ pub fn sphere(rho: Vec3, level: u32) -> (Scene, f64) {
     s.add_mesh("sphere", v, i, m);
     (s, area)
 }
-

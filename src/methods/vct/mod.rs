@@ -82,7 +82,9 @@ impl Layout {
     /// surface's lobe) with their mips (each level an eighth of the one
     /// below: at most 8/7 of the finest).
     pub fn bytes(&self) -> u64 {
-        let mips: u64 = (0..self.levels).map(|k| (self.side as u64 >> k).pow(3)).sum();
+        let mips: u64 = (0..self.levels)
+            .map(|k| (self.side as u64 >> k).pow(3))
+            .sum();
         self.cells() * volume::ACCUM_WORDS as u64 * 4 + 3 * 16 * mips
     }
 }

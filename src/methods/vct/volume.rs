@@ -108,17 +108,20 @@ impl Vct {
                 | vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuOnly,
         )?;
-        // Trilinear between cells and between mips; outside the grid, nothing.
+        // Trilinear between cells and between mips. Clamped to the edge: the
+        // grid's cube is the scene's bounds, so a coarse level's edge cells
+        // hold the walls there, and an empty border blended in would make
+        // them transparent wherever a sample is nearer the edge than the
+        // cells' centres (at the coarsest levels, nearly everywhere).
         let sampler = Sampler::new(
             gpu,
             &vk::SamplerCreateInfo::default()
                 .mag_filter(vk::Filter::LINEAR)
                 .min_filter(vk::Filter::LINEAR)
                 .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
                 .max_lod((layout.levels - 1) as f32),
         )?;
 
