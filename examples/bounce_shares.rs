@@ -49,11 +49,6 @@ struct Row {
 fn measure(gpu: &Gpu, name: &str, size: u32, spp: u32) -> Result<Row> {
     let mut scene = isr::bench::scenes::build(name)?;
     scene.animation = None;
-    if !gpu.features.sampled_image_array_indexing {
-        if let Some(w) = isr::scene::one_texture::keep_one(&mut scene) {
-            eprintln!("warning: {name}: {w}");
-        }
-    }
     // The bench's G-buffer and shadow maps, for its mask.
     let settings = RenderSettings {
         width: size,

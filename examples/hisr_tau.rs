@@ -156,10 +156,7 @@ fn main() -> Result<()> {
     let mut measured: Vec<(String, Vec<Cell>)> = vec![];
     for name in &o.scenes {
         let bench = scenes::find(name)?;
-        let mut scene = scenes::build(name)?;
-        if !gpu.features.sampled_image_array_indexing {
-            isr::scene::one_texture::keep_one(&mut scene);
-        }
+        let scene = scenes::build(name)?;
         let (size, rsm) = match o.size {
             Some(n) => (n, n),
             None => bench.size.unwrap_or((128, 128)),

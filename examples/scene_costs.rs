@@ -49,11 +49,8 @@ fn main() -> anyhow::Result<()> {
     let mut rows = vec![];
     for name in names {
         let started = Instant::now();
-        let mut scene = scenes::build(name)?;
+        let scene = scenes::build(name)?;
         let load_ms = started.elapsed().as_secs_f64() * 1e3;
-        if !gpu.features.sampled_image_array_indexing {
-            isr::scene::one_texture::keep_one(&mut scene);
-        }
         let state = scene.pose_at(0.1)?;
         let triangles = scene.triangle_count();
         let vertices: usize = scene.meshes.iter().map(|m| m.vertices.len()).sum();

@@ -33,6 +33,10 @@ struct FrameUniforms {
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
     vec4 grid_cube;         // the voxel grid's cube around this frame's posed scene:
                             // xyz its min corner (m), w the side of a finest cell (m)
+    vec3 scene_min;         // the scene's bounds as loaded (m; relative to the render
+    float pad4;             // origin like every position): fixed for a run, so what
+    vec3 scene_max;         // is fitted to them does not change size as objects move
+    float pad5;
 };
 
 // light_kind: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
@@ -118,13 +122,14 @@ const uint GEO_HAS_GEOMETRY = 1u;  // at least one pixel of the texel sees geome
 const uint GEO_SMOOTH = 2u;        // fully covered, depth range and normal spread under the thresholds
 const uint GEO_SPLIT = 4u;         // has geometry and is not a leaf: not smooth, or 2:1 balance
 
-// One glTF material (std430 storage buffer, set 0, binding 1 of scene passes).
+// One material (std430 storage buffer, set 1, binding 0 of scene passes).
 struct MaterialGpu {
-    vec4 base_color;  // linear RGBA albedo factor
-    int texture;      // index into the scene texture array, -1 for none
-    int pad0;
-    int pad1;
-    int pad2;
+    vec4 base_color;     // linear RGBA albedo factor
+    int texture_array;    // the texture's array (texture_array_N of material.glsl), -1 for none
+    int texture_layer;    // its layer in that array
+    vec2 texture_scale;   // where in the layer the texture is: sampled at
+    vec2 texture_offset;  // fract(uv) * texture_scale + texture_offset
+    vec2 pad0;
 };
 
 // Push constants of one dispatch of pass visibility-grid (voxel_grid/voxelize.comp):

@@ -42,6 +42,12 @@ pub struct FrameUniforms {
     /// The voxel grid's cube around this frame's posed scene: xyz its min
     /// corner, w a finest cell's side (m; `voxel_grid::grid_cube`).
     pub grid_cube: [f32; 4],
+    /// The scene's bounds as loaded (relative to the render origin): fixed
+    /// for a run, so what is fitted to them keeps its size as objects move.
+    pub scene_min: [f32; 3],
+    pub pad4: f32,
+    pub scene_max: [f32; 3],
+    pub pad5: f32,
 }
 
 /// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.
@@ -169,11 +175,15 @@ pub const GEO_SPLIT: u32 = 4;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MaterialGpu {
     pub base_color: [f32; 4],
-    /// Texture index, -1 for none.
-    pub texture: i32,
-    pub pad0: i32,
-    pub pad1: i32,
-    pub pad2: i32,
+    /// The texture's array (`frame::texture_arrays`), -1 for none.
+    pub texture_array: i32,
+    /// Its layer in that array.
+    pub texture_layer: i32,
+    /// Where in the layer the texture is: sampled at `fract(uv) * scale +
+    /// offset` (`TexturePlan::transform`).
+    pub texture_scale: [f32; 2],
+    pub texture_offset: [f32; 2],
+    pub pad0: [f32; 2],
 }
 
 /// `DrawPush`: push constants of one scene draw.

@@ -21,6 +21,7 @@ pub mod multires;
 pub mod output;
 pub mod passes;
 pub mod pathtrace;
+pub mod placement;
 pub mod progress;
 pub mod readback;
 pub mod regular_vpls;

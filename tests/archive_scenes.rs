@@ -3,8 +3,9 @@
 //! the repository; README, "Scenes from the archives"): each loads and
 //! renders one HISR frame at 64x64 under validation, with its light and
 //! camera placed by its scene description and, through the binary, by
-//! `--light` and `--camera` on a bare OBJ; a textured Sponza material's
-//! albedo reaches the G-buffer; the bench knows the scenes and their sizes.
+//! `--light` and `--camera` on a bare OBJ; each of Sponza's ten textures
+//! reaches the G-buffer on every device; the bench knows the scenes and their
+//! sizes.
 //! The scenes are loaded once per test binary. Without the archive the
 //! tests fail and say where to get it.
 mod common;
@@ -15,7 +16,7 @@ use glam::{Vec2, Vec3};
 use isr::bench::scenes;
 use isr::renderer::Renderer;
 use isr::scene::description::{archive_hint, archive_root};
-use isr::scene::Scene;
+use isr::scene::{Camera, Scene};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -53,15 +54,6 @@ fn loaded() -> &'static Vec<(&'static str, Scene)> {
     })
 }
 
-/// `scene` as a device that cannot index textures takes it.
-fn fitted(gpu: &isr::vk::Gpu, scene: &Scene) -> Scene {
-    let mut s = scene.clone();
-    if !gpu.features.sampled_image_array_indexing {
-        isr::scene::one_texture::keep_one(&mut s);
-    }
-    s
-}
-
 #[test]
 fn each_archive_scene_renders_a_hisr_frame_lit_and_framed_by_its_description() {
     let gpu = validating_gpu();
@@ -77,9 +69,8 @@ fn each_archive_scene_renders_a_hisr_frame_lit_and_framed_by_its_description() {
         // room's eight).
         assert_eq!(scene.triangle_count(), triangles, "{name}");
         assert!(scene.animation_duration().is_some(), "{name} moves");
-        let s = fitted(&gpu, scene);
-        let mut r = Renderer::new(&gpu, &s, &sized("hisr", 64, 64, 64)).unwrap();
-        r.update(&s.pose_at(0.5).unwrap()).unwrap();
+        let mut r = Renderer::new(&gpu, scene, &sized("hisr", 64, 64, 64)).unwrap();
+        r.update(&scene.pose_at(0.5).unwrap()).unwrap();
         r.render_frames(1, |_| {}).unwrap();
         let out = r.readback().unwrap();
         drop(r);
@@ -169,6 +160,10 @@ fn each_archive_obj_renders_a_hisr_frame_lit_and_framed_from_the_command_line() 
         // The command line's light and camera replaced the defaults.
         assert!(!ran.stderr.contains("default spot light"), "{}", ran.stderr);
         assert!(!ran.stderr.contains("default camera"), "{}", ran.stderr);
+        // Every texture is sampled as it is: none replaced by its mean
+        // colour, none shrunk.
+        assert!(!ran.stderr.contains("mean colour"), "{}", ran.stderr);
+        assert!(!ran.stderr.contains("shrunk"), "{}", ran.stderr);
         let img = image::open(&png).unwrap().to_rgb8();
         let bright = img
             .pixels()
@@ -182,18 +177,52 @@ fn each_archive_obj_renders_a_hisr_frame_lit_and_framed_from_the_command_line() 
     }
 }
 
-/// A textured Sponza material: the G-buffer's albedo where the camera
-/// looks at one of its triangles is Kd times the texture decoded here, at
-/// that point's texture coordinates (bilinear, in linear values, repeat).
+/// Each of Sponza's ten textures: all ten are bound, each in a layer of its
+/// own, and the G-buffer's albedo where the camera looks at one of the
+/// texture's triangles is Kd times the texture decoded here, at that
+/// point's texture coordinates (bilinear, in linear values, repeat), at a
+/// point whose texel is unlike the texture's mean. One renderer, the
+/// camera moved between frames.
 #[test]
-fn a_textured_sponza_albedo_reaches_the_g_buffer() {
+fn each_textured_sponza_albedo_reaches_the_g_buffer() {
     let root = archive();
     let gpu = validating_gpu();
     let (_, sponza) = loaded().iter().find(|(n, _)| *n == "sponza").unwrap();
-    let mut s = fitted(&gpu, sponza);
+    let mut s = sponza.clone();
     s.animation = None;
-    let kept = 0;
-    let texture = &s.textures[kept];
+    assert_eq!(s.textures.len(), 10);
+    let mut r = Renderer::new(&gpu, &s, &sized("none", 65, 65, 64)).unwrap();
+    let plan = &r.scene.plan;
+    let layers: std::collections::HashSet<(u32, u32)> =
+        plan.placements.iter().map(|p| (p.array, p.layer)).collect();
+    assert_eq!(layers.len(), 10, "{plan:?}");
+    for (k, texture) in s.textures.iter().enumerate() {
+        let (expected, uv, mean, camera) = textured_view(&root, &s, k);
+        let mut state = s.rest_state();
+        state.camera = camera;
+        r.update(&state).unwrap();
+        r.render_frames(1, |_| {}).unwrap();
+        let out = r.readback().unwrap();
+        let got = Vec3::from_slice(&out.albedo[32 * 65 + 32][..3]);
+        assert!(
+            (got - expected).abs().max_element() < 0.02,
+            "texture {} at uv {uv}: G-buffer albedo {got}, decoded texel times Kd {expected} (mean {mean})",
+            texture.name
+        );
+    }
+    drop(r);
+    assert_validation_clean(&gpu);
+}
+
+/// For texture `k` of Sponza `s`: Kd times the texture decoded here at the
+/// centroid of one of the largest triangles mapped with it whose texel there
+/// is unlike the texture's mean (so that a wrong texture or texture
+/// coordinate shows), that centroid's texture coordinates, Kd times the
+/// mean, and a camera just in front of the centroid looking at it along
+/// the normal (65x65, so that the middle pixel's centre is the image's
+/// centre).
+fn textured_view(root: &std::path::Path, s: &Scene, k: usize) -> (Vec3, Vec2, Vec3, Camera) {
+    let texture = &s.textures[k];
     let decoded = image::open(root.join("sponza/textures").join(&texture.name))
         .unwrap_or_else(|e| panic!("{}: {e}", texture.name))
         .to_rgba8();
@@ -227,15 +256,17 @@ fn a_textured_sponza_albedo_reaches_the_g_buffer() {
             + texel(x0, y0 + 1) * (1.0 - fx) * fy
             + texel(x0 + 1, y0 + 1) * fx * fy
     };
-    let mean = isr::scene::one_texture::mean_linear(texture);
-    // The largest triangles of the materials with this texture, one whose
-    // texel at its centroid is unlike the texture's mean (so that a wrong
-    // texture coordinate shows).
+    let pixels = decoded.pixels().count() as f32;
+    let mean = decoded
+        .pixels()
+        .map(|p| Vec3::new(linear(p.0[0]), linear(p.0[1]), linear(p.0[2])))
+        .sum::<Vec3>()
+        / pixels;
     let mut candidates = vec![];
     for inst in &s.instances {
         let mesh = &s.meshes[inst.mesh];
         let m = &s.materials[mesh.material];
-        if m.texture != Some(kept) {
+        if m.texture != Some(k) {
             continue;
         }
         for t in mesh.indices.chunks_exact(3) {
@@ -256,36 +287,31 @@ fn a_textured_sponza_albedo_reaches_the_g_buffer() {
             ));
         }
     }
-    assert!(!candidates.is_empty(), "no material uses the kept texture");
+    assert!(
+        !candidates.is_empty(),
+        "no material uses texture {}",
+        texture.name
+    );
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
     let (area2, centroid, normal, uv, kd) = *candidates
         .iter()
         .take(200)
         .find(|c| (c.4 * bilinear(c.3) - c.4 * mean).abs().max_element() > 0.05)
-        .expect("a large triangle whose texel differs from the mean");
-    let expected = kd * bilinear(uv);
-    // From just in front of the centroid, looking at it along the normal;
-    // 65x65, so that the middle pixel's centre is the image's centre.
+        .unwrap_or_else(|| {
+            panic!(
+                "texture {}: no large triangle whose texel differs from the mean",
+                texture.name
+            )
+        });
     let d = 0.02 * area2.sqrt();
-    s.camera = isr::scene::Camera::look_at(
+    let camera = Camera::look_at(
         centroid + normal * d,
         centroid,
         pick_up(normal),
         5f32.to_radians(),
         d * 0.1,
     );
-    let mut r = Renderer::new(&gpu, &s, &sized("none", 65, 65, 64)).unwrap();
-    r.update(&s.rest_state()).unwrap();
-    r.render_frames(1, |_| {}).unwrap();
-    let out = r.readback().unwrap();
-    drop(r);
-    assert_validation_clean(&gpu);
-    let got = Vec3::from_slice(&out.albedo[32 * 65 + 32][..3]);
-    assert!(
-        (got - expected).abs().max_element() < 0.02,
-        "texture {} at uv {uv}: G-buffer albedo {got}, decoded texel times Kd {expected} (mean {mean})",
-        texture.name
-    );
+    (kd * bilinear(uv), uv, kd * mean, camera)
 }
 
 fn pick_up(n: Vec3) -> Vec3 {
@@ -334,4 +360,38 @@ fn the_bench_runs_the_archive_scenes_at_their_own_size() {
     // The default run is the five stress scenes, as before.
     let plan = isr::bench::BenchArgs::default().plan().unwrap();
     assert_eq!(plan.scenes.len(), 5);
+}
+
+/// Each archive OBJ, bare (no description, `--light` or `--camera`), at
+/// 128x128 with the default method: the placed camera sees geometry in a
+/// quarter of the image or more and the placed light lights half of that
+/// or more (`placement`). The loader's spot and +Z camera alone: Sponza
+/// and the conference room black, Sibenik 8% lit, the bunny 5%.
+#[test]
+fn each_archive_obj_rendered_bare_is_framed_and_lit() {
+    let root = archive();
+    let dir = temp_dir("archive-bare");
+    for (file, inside) in [
+        ("sponza/sponza.obj", true),
+        ("sibenik/sibenik.obj", true),
+        ("conference/conference.obj", true),
+        ("bunny/bunny.obj", false),
+    ] {
+        let name = file.split('/').next().unwrap();
+        let seen = common::framing::render_bare(&dir, name, &root.join(file), 128, &[]);
+        let line = seen
+            .stderr
+            .lines()
+            .find(|l| l.contains("placed"))
+            .unwrap_or_default();
+        eprintln!(
+            "{name}: geometry {:.0}%, lit {:.0}% of it: {line}",
+            100.0 * seen.geometry as f64 / seen.pixels as f64,
+            100.0 * seen.lit as f64 / seen.geometry.max(1) as f64
+        );
+        assert!(seen.framed_and_lit(), "{name}: {seen:?}");
+        assert_eq!(line.contains("standing inside"), inside, "{name}: {line}");
+        // Sponza's roof is open: a sun comes through it.
+        assert_eq!(line.contains("a sun"), name == "sponza", "{name}: {line}");
+    }
 }

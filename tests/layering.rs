@@ -21,7 +21,7 @@ const LAYERS: &[&[&str]] = &[
     &["methods", "readback"],
     &["method_args", "debug_view", "output"],
     &["renderer", "pathtrace"],
-    &["report", "soak", "exact_visibility"],
+    &["report", "soak", "exact_visibility", "placement"],
     &["viewer", "bench"],
     &["cli"],
 ];

@@ -154,9 +154,6 @@ fn direct_light_in_the_sibenik_cathedral_matches_the_path_tracer_away_from_edges
     let path = isr::scene::description::archive_root().join("sibenik/sibenik.obj");
     let mut scene = isr::scene::load_file(&path, &Default::default())
         .unwrap_or_else(|e| panic!("{e:#}: {}", isr::scene::description::archive_hint()));
-    if !gpu.features.sampled_image_array_indexing {
-        isr::scene::one_texture::keep_one(&mut scene);
-    }
     scene.camera = Camera::look_at(
         Vec3::new(-17.0, -8.0, 0.0),
         Vec3::new(8.0, -4.0, 0.0),

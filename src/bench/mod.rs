@@ -148,16 +148,15 @@ pub struct SceneSpec {
 }
 
 impl SceneSpec {
-    /// The scene, fitted to what `gpu` can sample (`scene::one_texture`).
-    fn load(&self, gpu: &Gpu) -> Result<Scene> {
-        let mut scene = match &self.file {
+    /// The scene, and a warning for each texture it shrinks to sample
+    /// (`frame::texture_arrays`).
+    fn load(&self) -> Result<Scene> {
+        let scene = match &self.file {
             Some(p) => crate::scene::load_file(p, &Default::default())?,
             None => scenes::build(&self.name)?,
         };
-        if !gpu.features.sampled_image_array_indexing {
-            if let Some(w) = crate::scene::one_texture::keep_one(&mut scene) {
-                eprintln!("warning: {}: {w}", self.name);
-            }
+        for w in crate::frame::texture_arrays::warnings(&scene.textures) {
+            eprintln!("warning: {}: {w}", self.name);
         }
         Ok(scene)
     }
@@ -482,7 +481,7 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     }
     let bar = crate::progress::bar(units, "frames");
     for (spec, passes) in &pending {
-        let scene = spec.load(&gpu)?;
+        let scene = spec.load()?;
         run_scene(&gpu, spec, &scene, passes, &journal, &bar)?;
     }
     bar.finish_and_clear();

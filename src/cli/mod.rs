@@ -323,7 +323,7 @@ fn render(args: RenderArgs) -> Result<()> {
     } else if let Some(dir) = &args.sequence {
         output::check_sequence_dir(dir)?;
     }
-    let mut scene = run.load_scene()?;
+    let scene = run.load_scene()?;
     let Some(descriptor) = gpu_method else {
         // Of the parameters, the path tracer reads the bounces alone.
         let bounces = crate::bounces::BOUNCES.name;
@@ -358,11 +358,6 @@ fn render(args: RenderArgs) -> Result<()> {
         bail!("--visibility exact renders one frame (it is the CPU limit, minutes a frame); drop --sequence");
     }
     let gpu = Gpu::new(&run.gpu_options())?;
-    if !gpu.features.sampled_image_array_indexing {
-        if let Some(w) = scene::one_texture::keep_one(&mut scene) {
-            eprintln!("warning: {w}");
-        }
-    }
     eprintln!(
         "rendering {} ({} triangles) at {}x{}, rsm {}, method {} on {}",
         scene.name,

@@ -147,6 +147,17 @@ impl RunArgs {
             )?,
             None => crate::scene::cornell::cornell_box(),
         };
+        // What the command line gives is not placed.
+        scene.bare.light &= self.light.is_empty();
+        scene.bare.camera &= self.camera.is_none();
+        let placed = crate::placement::place_bare(&mut scene);
+        if placed.is_some() {
+            // The loader's warnings of its made-up light and camera no
+            // longer hold: the line below says what replaced them.
+            scene
+                .warnings
+                .retain(|w| !(w.contains("default spot light") || w.contains("default camera")));
+        }
         if !self.light.is_empty() || self.camera.is_some() {
             let lights: Vec<(String, crate::scene::description::LightSpec)> = self
                 .light
@@ -162,8 +173,13 @@ impl RunArgs {
                     || (self.camera.is_some() && w.contains("default camera")))
             });
         }
+        let shrunk = crate::frame::texture_arrays::warnings(&scene.textures);
+        scene.warnings.extend(shrunk);
         for w in &scene.warnings {
             eprintln!("warning: {w}");
+        }
+        if let Some(p) = placed {
+            eprintln!("{}", p.line);
         }
         Ok(scene)
     }

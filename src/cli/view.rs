@@ -48,17 +48,7 @@ pub fn view(args: ViewArgs) -> Result<()> {
         Some(path) => viewer::script::load(path)?,
         None => Vec::new(),
     };
-    let mut scene = run.load_scene()?;
-    if scene.textures.len() > 1 {
-        // The device the viewer will open, asked whether it can index
-        // textures (`scene::one_texture`).
-        let gpu = crate::vk::Gpu::new(&run.gpu_options())?;
-        if !gpu.features.sampled_image_array_indexing {
-            if let Some(w) = crate::scene::one_texture::keep_one(&mut scene) {
-                eprintln!("warning: {w}");
-            }
-        }
-    }
+    let scene = run.load_scene()?;
     viewer::run(
         &scene,
         viewer::ViewOptions {

@@ -20,6 +20,8 @@ pub struct AddedMemory {
     /// The point lights' six-layer cube RSM, when the scene has one
     /// (`passes::rsm_cube::cube_bytes`).
     pub cube_rsm: u64,
+    /// The scene's texture arrays (`texture_arrays::TexturePlan::bytes`).
+    pub textures: u64,
 }
 
 /// Checks `s` against `gpu`'s limits and memory; `method_bytes` is what the
@@ -135,12 +137,40 @@ pub fn check_light_views(
         );
     }
     let extra = light_memory_estimate(s, views, instances, added.cube_rsm);
-    let run = memory_estimate(s, added.method);
+    let run = memory_estimate(s, added.method) + added.textures;
     within_memory_share(
         &light_views_need(lights.len(), views, extra, run),
         run + extra,
         device_local_heap(gpu),
         "Remove lights or choose a smaller resolution",
+    )
+}
+
+/// Checks that the scene's texture arrays (`textures` bytes) fit beside the
+/// run's targets and the method's `method_bytes`.
+pub fn check_textures(
+    gpu: &Gpu,
+    s: &RenderSettings,
+    method_bytes: u64,
+    textures: u64,
+) -> Result<()> {
+    let run = memory_estimate(s, method_bytes);
+    within_memory_share(
+        &textures_need(textures, run),
+        run + textures,
+        device_local_heap(gpu),
+        "Use a scene with smaller textures, or choose a smaller resolution",
+    )
+}
+
+/// The start of [`check_textures`]' refusal.
+fn textures_need(textures: u64, run: u64) -> String {
+    format!(
+        "the scene's textures need about {} MiB of GPU memory besides the {} MiB of the run, {} \
+         MiB in all",
+        textures >> 20,
+        run >> 20,
+        (textures + run) >> 20
     )
 }
 
@@ -244,6 +274,19 @@ mod tests {
              2048 MiB heap. Choose less"
         );
         within_memory_share("", usable_memory(heap), heap, "").unwrap();
+        let what = textures_need(900 * MIB, 1000 * MIB);
+        assert_eq!(
+            what,
+            "the scene's textures need about 900 MiB of GPU memory besides the 1000 MiB of the \
+             run, 1900 MiB in all"
+        );
+        let e = within_memory_share(&what, 1900 * MIB, heap, "Use smaller textures")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("1900 MiB in all; isr plans to use at most 1843 MiB"),
+            "{e}"
+        );
         within_memory_share("", u64::MAX, 0, "").unwrap();
         let what = light_views_need(3, 8, 400 * MIB, 1500 * MIB);
         assert_eq!(

@@ -9,6 +9,7 @@
 pub mod check;
 pub mod scene_gpu;
 pub mod targets;
+pub mod texture_arrays;
 pub mod uniforms;
 
 pub use scene_gpu::SceneGpu;

@@ -162,7 +162,7 @@ pub struct Samplers {
     pub nearest: vk::Sampler,
     /// Hardware 2x2 PCF on reversed-Z depth: passes where reference >= stored.
     pub shadow: vk::Sampler,
-    /// Scene textures: bilinear, repeat.
+    /// Scene textures (`texture_arrays`): bilinear, repeat at a layer's edges.
     pub texture: vk::Sampler,
     _owned: [Sampler; 3],
 }

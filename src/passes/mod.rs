@@ -213,7 +213,7 @@ impl ScenePass {
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
                 specialization: &[
-                    Spec::int("TEXTURE_COUNT", setup.scene.texture_count() as i32),
+                    Spec::int("TEXTURE_ARRAYS", setup.scene.texture_arrays_in_use()),
                     Spec::int("VIEW_FROM_LIGHT", from_light as i32),
                 ],
                 ..Default::default()

@@ -84,8 +84,8 @@ impl CubeRsmPass {
                 depth_test: Some(vk::CompareOp::GREATER),
                 dynamic_cull: true,
                 specialization: &[crate::vk::pipeline::Spec::int(
-                    "TEXTURE_COUNT",
-                    setup.scene.texture_count() as i32,
+                    "TEXTURE_ARRAYS",
+                    setup.scene.texture_arrays_in_use(),
                 )],
                 ..Default::default()
             },

@@ -33,6 +33,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// the precision it has at the origin.
 struct Shading<'a> {
     scene: &'a Scene,
+    /// The scene's textures as the GPU samples them (a texture larger than
+    /// a texture array's layer shrunk as it is for the GPU,
+    /// `frame::texture_arrays::fitted`), so that both see the same texels.
+    textures: Vec<std::borrow::Cow<'a, crate::scene::Texture>>,
     bvh: Bvh,
     /// The lights, their positions relative to `origin`.
     lights: Vec<Light>,
@@ -169,6 +173,7 @@ impl Shading<'_> {
             .collect();
         Shading {
             scene,
+            textures: crate::frame::texture_arrays::fitted(&scene.textures),
             bvh: Bvh::new(triangles),
             lights,
             origin,
@@ -176,8 +181,10 @@ impl Shading<'_> {
     }
 
     fn texture(&self, index: usize, uv: Vec2) -> Vec3 {
-        let t = &self.scene.textures[index];
-        // Bilinear with repeat, on linear values, as the GPU sampler does.
+        let t = &self.textures[index];
+        // Bilinear with repeat, on linear values, texel centres at
+        // (i + 0.5) / size, as shaders/material.glsl filters
+        // (docs/algorithm.md section 3, step 1).
         let (w, h) = (t.width as f32, t.height as f32);
         let x = uv.x * w - 0.5;
         let y = uv.y * h - 0.5;

@@ -101,8 +101,8 @@ impl<'g> Renderer<'g> {
             self.gpu,
             settings,
             &self.state.lights,
-            self.views.len(),
-            self.state.instance_transforms.len(),
+            (self.views.len(), self.state.instance_transforms.len()),
+            self.scene.plan.bytes(),
         )?;
         // The grid is made with the run (the frame sets bind it).
         let grid_in_use = reads_grid(descriptor, settings);

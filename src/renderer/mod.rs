@@ -10,7 +10,10 @@
 //! between frames (camera, light, instance transforms) is data in the frame
 //! set of the frame's slot, written just before it is submitted.
 
-use crate::frame::check::{check_light_views, check_ranges, check_settings, AddedMemory};
+use crate::frame::check::{
+    check_light_views, check_ranges, check_settings, check_textures, AddedMemory,
+};
+use crate::frame::texture_arrays::TexturePlan;
 use crate::frame::uniforms::{frame_uniforms, instance_transforms};
 use crate::frame::{FrameContext, FrameSet, Samplers, SceneGpu, Setup, Targets};
 use crate::gpu_types::{FrameUniforms, RunUniforms};
@@ -129,12 +132,16 @@ impl<'g> Renderer<'g> {
             size: (settings.width, settings.height),
         };
         let views = all_views(&state, &fitting, settings.rsm_resolution);
+        // The texture arrays' memory is checked with the rest before anything
+        // is allocated; `SceneGpu::new` makes the same plan again (it is
+        // cheap: sizes only).
+        let textures = TexturePlan::new(&scene.textures)?.bytes();
         let descriptor = check_run(
             gpu,
             settings,
             &scene.lights,
-            views.len(),
-            scene.instances.len(),
+            (views.len(), scene.instances.len()),
+            textures,
         )?;
         let samplers = Samplers::new(gpu)?;
         let scene_gpu =
@@ -355,20 +362,21 @@ impl<'g> Renderer<'g> {
 }
 
 /// Checks `settings` for a run with `lights` (`views` RSMs, `instances`
-/// transforms) on `gpu` before anything is allocated: the shared sizes, the
-/// method's parameters and checks, then the memory it all takes. Returns
-/// the method's descriptor.
+/// transforms) and texture arrays of `textures` bytes on `gpu` before
+/// anything is allocated: the shared sizes, the method's parameters and
+/// checks, then the memory it all takes. Returns the method's descriptor.
 fn check_run(
     gpu: &Gpu,
     settings: &RenderSettings,
     lights: &[crate::scene::Light],
-    views: usize,
-    instances: usize,
+    (views, instances): (usize, usize),
+    textures: u64,
 ) -> Result<&'static dyn Descriptor> {
     check_ranges(settings)?;
     let d = crate::methods::check(settings)?;
     let method = crate::methods::memory(d, settings);
     check_settings(gpu, settings, method)?;
+    check_textures(gpu, settings, method, textures)?;
     crate::voxel_grid::check_device(gpu, settings)?;
     let cube_rsm = match lights.iter().any(|l| l.kind == LightKind::Point) {
         true => crate::passes::rsm_cube::cube_bytes(settings.rsm_resolution),
@@ -379,7 +387,11 @@ fn check_run(
         settings,
         lights,
         (views, instances),
-        AddedMemory { method, cube_rsm },
+        AddedMemory {
+            method,
+            cube_rsm,
+            textures,
+        },
     )?;
     Ok(d)
 }

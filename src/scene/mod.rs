@@ -16,7 +16,6 @@ mod light_camera;
 pub mod limits;
 pub mod motion;
 pub mod obj_load;
-pub mod one_texture;
 pub mod text;
 mod texture_decode;
 mod uri;
@@ -245,6 +244,18 @@ pub struct Scene {
     /// it in; the renderer never needs it (images do not depend on where
     /// the scene is).
     pub origin: glam::DVec3,
+    /// Which of the light and the camera the loader made up because the
+    /// file (an OBJ, a glTF without them) had none and no description gave
+    /// them: the command line places those by looking at the scene
+    /// (`placement`).
+    pub bare: Bare,
+}
+
+/// See [`Scene::bare`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Bare {
+    pub light: bool,
+    pub camera: bool,
 }
 
 impl Scene {
@@ -261,6 +272,7 @@ impl Scene {
             warnings: vec![],
             animation: None,
             origin: glam::DVec3::ZERO,
+            bare: Bare::default(),
         }
     }
 

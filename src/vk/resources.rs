@@ -14,7 +14,8 @@ use std::sync::Arc;
 
 pub struct Image {
     pub image: vk::Image,
-    /// A view of all mips and layers (2D, or 2D array when `layers > 1`).
+    /// A view of all mips and layers (2D, or 2D array when `layers > 1` or
+    /// made by [`Image::array`]).
     pub view: vk::ImageView,
     /// One view per mip level (all layers), for storage writes and attachments.
     pub mip_views: Vec<vk::ImageView>,
@@ -89,7 +90,18 @@ pub fn texel_bytes(format: vk::Format) -> u64 {
 
 impl Image {
     pub fn new(gpu: &Gpu, desc: &ImageDesc) -> Result<Self> {
-        Self::create(gpu, desc, 1)
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        Self::with_view_type(gpu, desc, view_type, 1)
+    }
+
+    /// An image whose views are 2D arrays whatever its layers: a shader's
+    /// `sampler2DArray` takes only such a view, one layer or many.
+    pub fn array(gpu: &Gpu, desc: &ImageDesc) -> Result<Self> {
+        Self::with_view_type(gpu, desc, vk::ImageViewType::TYPE_2D_ARRAY, 1)
     }
 
     /// A 3D image of `depth` texels along z (`desc.layers` must be 1), its
@@ -97,12 +109,17 @@ impl Image {
     /// between mips).
     pub fn volume(gpu: &Gpu, desc: &ImageDesc, depth: u32) -> Result<Self> {
         anyhow::ensure!(desc.layers == 1, "volume {} has one layer", desc.name);
-        Self::create(gpu, desc, depth)
+        Self::with_view_type(gpu, desc, vk::ImageViewType::TYPE_3D, depth)
     }
 
-    fn create(gpu: &Gpu, desc: &ImageDesc, depth: u32) -> Result<Self> {
+    fn with_view_type(
+        gpu: &Gpu,
+        desc: &ImageDesc,
+        view_type: vk::ImageViewType,
+        depth: u32,
+    ) -> Result<Self> {
         let aspect = aspect_of(desc.format);
-        let volume = depth > 1;
+        let volume = view_type == vk::ImageViewType::TYPE_3D;
         let info = vk::ImageCreateInfo::default()
             .image_type(if volume {
                 vk::ImageType::TYPE_3D
@@ -164,13 +181,6 @@ impl Image {
         let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
         out.allocation = Some(allocation);
         unsafe { gpu.device.bind_image_memory(image, memory, offset)? };
-        let view_type = if volume {
-            vk::ImageViewType::TYPE_3D
-        } else if desc.layers > 1 {
-            vk::ImageViewType::TYPE_2D_ARRAY
-        } else {
-            vk::ImageViewType::TYPE_2D
-        };
         let make_view = |base_mip: u32, mips: u32| {
             let range = vk::ImageSubresourceRange {
                 aspect_mask: aspect,

@@ -119,7 +119,7 @@ impl SurfacePass {
                 push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
                 scene_vertices: true,
                 specialization: &[
-                    Spec::int("TEXTURE_COUNT", setup.scene.texture_count() as i32),
+                    Spec::int("TEXTURE_ARRAYS", setup.scene.texture_arrays_in_use()),
                     Spec::int("GRID_SAMPLES", samples as i32),
                 ],
                 // Both faces count: cull modes are set per draw, as dynamic state.

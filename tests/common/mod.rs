@@ -13,6 +13,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod framing;
 pub mod gltf;
 pub mod grid;
 pub mod measure;

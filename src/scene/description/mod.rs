@@ -318,6 +318,8 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
         .map(|(i, l)| (format!("light {i}"), l.clone()))
         .collect();
     apply(&mut scene, &lights, d.camera.as_ref())?;
+    // A description places what it leaves out as it always did.
+    scene.bare = super::Bare::default();
     Ok(scene)
 }
 

@@ -243,7 +243,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             (origin + l.position.as_dvec3()).to_array(),
             l.intensity
         ));
-        out.lights = vec![l];
+        (out.lights, out.bare.light) = (vec![l], true);
     } else {
         bound.lights = lights.iter().map(|&(node, _)| node).collect();
         out.lights = lights.into_iter().map(|(_, l)| l).collect();
@@ -254,7 +254,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
             out.camera = c;
         }
         None => {
-            out.camera = fitted_camera(lo, hi);
+            (out.camera, out.bare.camera) = (fitted_camera(lo, hi), true);
             warnings.push(
                 "no perspective camera: using a default camera on +Z looking at the scene's center"
                     .into(),

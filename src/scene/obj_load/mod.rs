@@ -111,6 +111,10 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sc
 /// The warnings that say an OBJ brings no light or camera and where the
 /// defaults are.
 fn with_default_warnings(mut scene: Scene) -> Scene {
+    scene.bare = super::Bare {
+        light: true,
+        camera: true,
+    };
     let light = scene.lights[0];
     scene.warnings.push(format!(
         "an OBJ has no lights: using a default spot light at {:.2?} pointing down (60 degree cone, {:.1} cd); place lights with --light or a scene description",

@@ -84,8 +84,6 @@ pub struct OptionalFeatures {
     pub shader_output_layer: bool,
     /// Atomics in fragment shaders (patch counts).
     pub fragment_atomics: bool,
-    /// Indexing the scene's texture array with a per-draw index.
-    pub sampled_image_array_indexing: bool,
 }
 
 /// Messages the validation layer reported, collected so that tests can fail on them.
@@ -354,14 +352,11 @@ impl Gpu {
                 && properties.limits.timestamp_compute_and_graphics == vk::TRUE,
             shader_output_layer: supported12.shader_output_layer == vk::TRUE,
             fragment_atomics: supported.fragment_stores_and_atomics == vk::TRUE,
-            sampled_image_array_indexing: supported.shader_sampled_image_array_dynamic_indexing
-                == vk::TRUE,
         };
         let enabled = vk::PhysicalDeviceFeatures::default()
             .pipeline_statistics_query(features.pipeline_statistics)
             .occlusion_query_precise(features.precise_occlusion)
-            .fragment_stores_and_atomics(features.fragment_atomics)
-            .shader_sampled_image_array_dynamic_indexing(features.sampled_image_array_indexing);
+            .fragment_stores_and_atomics(features.fragment_atomics);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
             .shader_output_layer(features.shader_output_layer);
         // Demote is required by Vulkan 1.3; glslang compiles `discard` to it for SPIR-V 1.6.
