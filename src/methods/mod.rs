@@ -23,6 +23,7 @@ pub mod none;
 pub mod reference;
 pub mod rsm_gather;
 pub mod rsm_splat;
+pub mod vct;
 
 use crate::frame::{FrameContext, Setup};
 use crate::gpu_types::RunUniforms;
@@ -47,6 +48,7 @@ pub static REGISTRY: &[&dyn Descriptor] = &[
     &isr::IsrMethod,
     &hisr::HisrMethod,
     &lpv::LpvMethod,
+    &vct::VctMethod,
     &reference::ReferenceMethod,
 ];
 

@@ -23,6 +23,8 @@ pub struct Image {
     /// Extent of mip 0.
     pub extent: vk::Extent2D,
     pub layers: u32,
+    /// Texels along z of mip 0: 1, or the depth of a volume (`Image::volume`).
+    pub depth: u32,
     pub mips: u32,
     pub aspect: vk::ImageAspectFlags,
     allocation: Option<Allocation>,
@@ -93,24 +95,42 @@ impl Image {
         } else {
             vk::ImageViewType::TYPE_2D
         };
-        Self::with_view_type(gpu, desc, view_type)
+        Self::with_view_type(gpu, desc, view_type, 1)
     }
 
     /// An image whose views are 2D arrays whatever its layers: a shader's
     /// `sampler2DArray` takes only such a view, one layer or many.
     pub fn array(gpu: &Gpu, desc: &ImageDesc) -> Result<Self> {
-        Self::with_view_type(gpu, desc, vk::ImageViewType::TYPE_2D_ARRAY)
+        Self::with_view_type(gpu, desc, vk::ImageViewType::TYPE_2D_ARRAY, 1)
     }
 
-    fn with_view_type(gpu: &Gpu, desc: &ImageDesc, view_type: vk::ImageViewType) -> Result<Self> {
+    /// A 3D image of `depth` texels along z (`desc.layers` must be 1), its
+    /// views 3D, so that samplers filter across z too (trilinear, and
+    /// between mips).
+    pub fn volume(gpu: &Gpu, desc: &ImageDesc, depth: u32) -> Result<Self> {
+        anyhow::ensure!(desc.layers == 1, "volume {} has one layer", desc.name);
+        Self::with_view_type(gpu, desc, vk::ImageViewType::TYPE_3D, depth)
+    }
+
+    fn with_view_type(
+        gpu: &Gpu,
+        desc: &ImageDesc,
+        view_type: vk::ImageViewType,
+        depth: u32,
+    ) -> Result<Self> {
         let aspect = aspect_of(desc.format);
+        let volume = view_type == vk::ImageViewType::TYPE_3D;
         let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
+            .image_type(if volume {
+                vk::ImageType::TYPE_3D
+            } else {
+                vk::ImageType::TYPE_2D
+            })
             .format(desc.format)
             .extent(vk::Extent3D {
                 width: desc.extent.width,
                 height: desc.extent.height,
-                depth: 1,
+                depth,
             })
             .mip_levels(desc.mips)
             .array_layers(desc.layers)
@@ -128,6 +148,7 @@ impl Image {
             format: desc.format,
             extent: desc.extent,
             layers: desc.layers,
+            depth,
             mips: desc.mips,
             aspect,
             allocation: None,
@@ -153,7 +174,7 @@ impl Image {
                     desc.name,
                     desc.extent.width,
                     desc.extent.height,
-                    desc.layers
+                    desc.layers * depth
                 )
             })?;
         // SAFETY: the memory is bound to this object only, and freed after it.
