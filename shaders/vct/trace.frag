@@ -24,10 +24,10 @@
 #include "frame.glsl"
 #include "vct/vct.glsl"
 
-layout(constant_id = 81) const int VCT_LEVELS = 7;
-layout(constant_id = 82) const int VCT_CONES = 6;
-layout(constant_id = 83) const bool VCT_LOBE = true;
-layout(constant_id = 84) const float VCT_RING_TAN = 0.57735;  // cones::ring_half_angle
+layout(constant_id = 91) const int VCT_LEVELS = 7;
+layout(constant_id = 92) const int VCT_CONES = 6;
+layout(constant_id = 93) const bool VCT_LOBE = true;
+layout(constant_id = 94) const float VCT_RING_TAN = 0.57735;  // cones::ring_half_angle
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;

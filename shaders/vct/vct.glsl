@@ -18,7 +18,7 @@
 #ifndef VCT_GLSL
 #define VCT_GLSL
 
-layout(constant_id = 80) const int VCT_SIZE = 64;
+layout(constant_id = 90) const int VCT_SIZE = 64;
 
 const uint ACCUM_WORDS = 8u;
 const float AREA_ONE = 4096.0;
