@@ -33,6 +33,10 @@ struct FrameUniforms {
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
     vec4 grid_cube;         // the voxel grid's cube around this frame's posed scene:
                             // xyz its min corner (m), w the side of a finest cell (m)
+    vec3 scene_min;         // the scene's bounds as loaded (m; relative to the render
+    float pad4;             // origin like every position): fixed for a run, so what
+    vec3 scene_max;         // is fitted to them does not change size as objects move
+    float pad5;
 };
 
 // light_kind: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).

@@ -42,6 +42,12 @@ pub struct FrameUniforms {
     /// The voxel grid's cube around this frame's posed scene: xyz its min
     /// corner, w a finest cell's side (m; `voxel_grid::grid_cube`).
     pub grid_cube: [f32; 4],
+    /// The scene's bounds as loaded (relative to the render origin): fixed
+    /// for a run, so what is fitted to them keeps its size as objects move.
+    pub scene_min: [f32; 3],
+    pub pad4: f32,
+    pub scene_max: [f32; 3],
+    pub pad5: f32,
 }
 
 /// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.

@@ -13,7 +13,7 @@ mod scheme;
 use common::*;
 use glam::{DVec3, IVec3, Vec3};
 use isr::methods::lpv::grid::{self, Cascade, Grid};
-use isr::methods::lpv::{CASCADES, ITERATIONS, OCCLUSION, SIZE};
+use isr::methods::lpv::{Layout, CASCADES, ITERATIONS, OCCLUSION, SIZE};
 use isr::readback::{read_regions, Region};
 use isr::scene::{cornell::cornell_box, Camera, LightKind, Scene};
 use isr::settings::RenderSettings;
@@ -28,6 +28,17 @@ fn some_scene() -> Scene {
         1.0,
         0.5,
     )
+}
+
+/// `width` x `width` pixels, an RSM of `rsm`, and the cells, cascades and
+/// steps the wall's values were measured at: three cascades of 32 cells
+/// (of 1/16, 1/8 and 1/4 m around the 4 m wide wall scene), 8 steps.
+fn settings_at(width: u32, rsm: u32, occlusion: bool) -> RenderSettings {
+    sized("lpv", width, width, rsm)
+        .with(&SIZE, 32)
+        .with(&CASCADES, 3)
+        .with(&ITERATIONS, 8)
+        .with(&OCCLUSION, occlusion)
 }
 
 fn settings(size: u32, cascades: u32, iterations: u32, occlusion: bool) -> RenderSettings {
@@ -123,8 +134,8 @@ fn a_single_vpl_in_an_empty_volume_falls_off_along_its_lobe() {
 #[test]
 fn injection_conserves_flux_in_every_cascade() {
     let gpu = gpu();
-    // RSM 64: every texel is a VPL (level 0).
-    let s = sized("lpv", 64, 64, 64);
+    // RSM 64: every texel is a VPL (level 0); three cascades of 32 cells.
+    let s = sized("lpv", 64, 64, 64).with(&SIZE, 32).with(&CASCADES, 3);
     let mut probe = Probe::new(&gpu, &cornell_with(cornell_box().lights), &s);
     let image = probe.render();
     // The probe is the method: the same image as the renderer's.
@@ -180,9 +191,9 @@ fn injection_conserves_flux_in_every_cascade() {
             "cascade {c}: {got} against {inside}"
         );
     }
-    // The finest cascade lies between the camera and the box; the others
-    // hold VPLs, the coarsest the whole box: every VPL.
-    assert_eq!(nonempty, 2);
+    // The cascades are fitted to the box (the camera outside it): every one
+    // lies in it and holds VPLs, the coarsest the whole box: every VPL.
+    assert_eq!(nonempty, 3);
     let all = injected.flux(l.cascades - 1);
     assert!(
         (all - total).abs().max_element() < 1e-5 * total.max_element(),
@@ -233,29 +244,47 @@ fn wall_scene() -> Scene {
 fn a_wall_in_the_geometry_volume_blocks_the_light_behind_it() {
     let scene = wall_scene();
     let gpu = gpu();
-    let read = |occlusion: bool| {
-        let s = sized("lpv", 64, 64, 128).with(&OCCLUSION, occlusion);
-        render(&gpu, &scene, &s, 1).readback
+    // 32 steps, once across a cascade (the default's rule): the receiver
+    // lies 14 finest cells from the wall's lit side, beyond 8 steps' reach.
+    let at = |occlusion| settings_at(64, 128, occlusion).with(&ITERATIONS, 32);
+    let s = at(true);
+    let rendered = render(&gpu, &scene, &s, 1);
+    let on = rendered.readback;
+    let off = render(&gpu, &scene, &at(false), 1).readback;
+    // The receiver's pixels that read the finest cascade (1/16 m cells, the
+    // wall 1.6 of them thick) alone: in a coarser one (1/8 m and up) the
+    // wall is thinner than a cell and leaks (8.6).
+    let l = Layout::of(&s);
+    let finest = grid::cascades(&rendered.uniforms, &l)[0];
+    // Positions are read back in world space; the cascades lie relative
+    // to the render origin.
+    let in_finest = |p: &[f32; 4], n: &[f32; 4]| {
+        let (p, n) = (dvec(p) - rendered.origin, dvec(n));
+        let g = finest.grid_position(p + 0.5 * finest.cell as f64 * n) - DVec3::splat(0.5);
+        let inner = g.min(DVec3::splat(l.size as f64 - 1.0) - g).min_element();
+        inner >= l.blend_cells() as f64
     };
-    let (on, off) = (read(true), read(false));
     if let Ok(dir) = std::env::var("LPV_DUMP") {
         for (name, r) in [("on", &on), ("off", &off)] {
             let img = image::RgbaImage::from_raw(r.width, r.height, r.display.clone()).unwrap();
             img.save(format!("{dir}/wall-{name}.png")).unwrap();
         }
     }
+    let receiver = |p: &[f32; 4], n: &[f32; 4]| p[3] > 0.0 && p[0] > 0.75 && in_finest(p, n);
     let behind = |r: &isr::readback::Readback| -> f64 {
         r.position
             .iter()
+            .zip(&r.normal)
             .zip(&r.indirect)
-            .filter(|(p, _)| p[3] > 0.0 && p[0] > 0.75)
+            .filter(|((p, n), _)| receiver(p, n))
             .map(|(_, e)| e[0] as f64)
             .sum()
     };
     let pixels = on
         .position
         .iter()
-        .filter(|p| p[3] > 0.0 && p[0] > 0.75)
+        .zip(&on.normal)
+        .filter(|(p, n)| receiver(p, n))
         .count();
     let (a, b) = (behind(&on), behind(&off));
     println!(
@@ -267,7 +296,7 @@ fn a_wall_in_the_geometry_volume_blocks_the_light_behind_it() {
     // The wall's surfels cover its geometry cells (A / h^2 >= 1): light
     // crossing it through a front face (along the normal) is blocked
     // entirely, through a side face (26.6 degrees off) to 1 - 0.93: at most
-    // 7% passes. Measured: 6.3%.
+    // 7% passes. Measured: 5.1%.
     assert!(a < 0.1 * b, "the wall leaves {:.3} of the light", a / b);
 }
 
@@ -279,7 +308,7 @@ fn at(sum: &Grid, cascades: &[Cascade], c: usize, p: DVec3, n: DVec3) -> f64 {
 #[test]
 fn occluded_propagation_is_the_scheme_and_the_geometry_volume_holds_the_surfels() {
     let gpu = gpu();
-    let mut probe = Probe::new(&gpu, &wall_scene(), &sized("lpv", 64, 64, 64));
+    let mut probe = Probe::new(&gpu, &wall_scene(), &settings_at(64, 64, true));
     probe.render();
     let l = probe.layout();
     let [light, eye] = probe.geometry().expect("occlusion is on by default");
@@ -322,9 +351,16 @@ fn occluded_propagation_is_the_scheme_and_the_geometry_volume_holds_the_surfels(
 #[test]
 fn cascades_nest() {
     // A floor 16 m wide under a sun from straight above, seen from 3 m up
-    // (reach 16 m: cells of 1/8, 1/4 and 1/2 m): a laterally uniform
+    // (32 cells: the coarsest cell is the first power of two with 29 cells
+    // over 16 m, 1 m; the others 1/4 and 1/2 m): a laterally uniform
     // emitter of exitance rho E = 1 W/m^2, which gives a downward-facing
-    // point above it 1 W/m^2 at any height.
+    // point above it 1 W/m^2 at any height. The RSM's 128 texels over the
+    // 16 m give every finest cell the same four VPLs (a 14 m floor, 1.3
+    // texels a cell, injects unevenly and the cascades part by 14%). 8
+    // steps: the floor's edge lies 8 cells from the centre of the coarsest
+    // cascade, where the scheme carries almost nothing (8.4), so each
+    // cascade sees the emitter as unbounded (the values below were measured
+    // at 8 steps).
     let camera = Camera::look_at(
         Vec3::new(0.0, 3.0, 0.0),
         Vec3::ZERO,
@@ -334,13 +370,13 @@ fn cascades_nest() {
     );
     let scene = floor_scene(sun(-Vec3::Y, 2.0), camera, 8.0, 0.5);
     let gpu = gpu();
-    let mut probe = Probe::new(&gpu, &scene, &sized("lpv", 64, 64, 128));
+    let mut probe = Probe::new(&gpu, &scene, &settings_at(64, 128, true));
     probe.render();
     let l = probe.layout();
     let cascades = grid::cascades(&probe.renderer.frame_uniforms(), &l);
     assert_eq!(
         cascades.iter().map(|c| c.cell).collect::<Vec<_>>(),
-        [0.125, 0.25, 0.5]
+        [0.25, 0.5, 1.0]
     );
     let sum = probe.sum();
     let origin = probe.renderer.render_origin();
@@ -468,6 +504,53 @@ fn cascades_snap_to_whole_cells_as_the_camera_moves() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn the_near_floor_of_the_cornell_box_is_lit_at_the_defaults() {
+    // The camera stands outside the box's open front: cascades sized from
+    // the camera's reach once lay in front of the box, and the floor's
+    // front half read almost nothing. Fitted to the box, LPV at its
+    // defaults gives that half within the goal's factor of 2 of the dense
+    // reference (every RSM texel a VPL, no visibility: the one-bounce
+    // light LPV approximates, on the same RSM), and the back half too.
+    let gpu = gpu();
+    let scene = cornell_at_rest(true);
+    let lpv = render(&gpu, &scene, &sized("lpv", 64, 64, 64), 1).readback;
+    let reference = render(&gpu, &scene, &sized("reference", 64, 64, 64), 1).readback;
+    // The floor's pixels (y = 0, facing up) in front of the box's middle
+    // (z > 0, toward the camera) and behind it, away from the walls.
+    let floor = |near: bool| {
+        let mean = |r: &isr::readback::Readback| {
+            let (mut sum, mut count) = (0.0, 0);
+            for ((p, n), e) in r.position.iter().zip(&r.normal).zip(&r.indirect) {
+                let on_floor = p[3] > 0.0 && p[1].abs() < 1e-3 && n[1] > 0.99;
+                let inner = p[0].abs() < 0.8 && p[2].abs() < 0.8;
+                if on_floor && inner && (p[2] > 0.0) == near {
+                    sum += dvec(e).element_sum();
+                    count += 1;
+                }
+            }
+            (sum / count.max(1) as f64, count)
+        };
+        let ((a, count), (b, _)) = (mean(&lpv), mean(&reference));
+        println!(
+            "{} floor ({count} pixels): lpv {a:.4}, reference {b:.4}: {:.3}",
+            if near { "near" } else { "far" },
+            a / b
+        );
+        // The box's blocks hide most of the far half at 64 x 64: a mean over
+        // 10 pixels is still a mean of the light across them.
+        assert!(
+            count > if near { 100 } else { 10 },
+            "the camera sees the floor"
+        );
+        a / b
+    };
+    for near in [true, false] {
+        let ratio = floor(near);
+        assert!(ratio > 0.5 && ratio < 2.0, "{ratio}");
     }
 }
 

@@ -7,11 +7,14 @@
 // settings; src/methods/lpv/ is their one writer):
 //   0 LPV_SIZE      cells per side of a cascade (a power of two)
 //   1 LPV_CASCADES  nested cascades, finest first
+//   2 LPV_AHEAD     how far ahead of the camera a cascade's centre aims, in
+//                   sides (grid::AHEAD)
 #ifndef LPV_GLSL
 #define LPV_GLSL
 
 layout(constant_id = 40) const int LPV_SIZE = 32;
 layout(constant_id = 41) const int LPV_CASCADES = 3;
+layout(constant_id = 46) const float LPV_AHEAD = 0.375;
 
 // Cells of all cascades: cascade c, cell (x, y, z) is cell
 // ((c * N + z) * N + y) * N + x. The injection images are 2D arrays of
@@ -25,30 +28,61 @@ int lpv_cell_index(int c, ivec3 cell) {
 
 // --- Placement (docs/algorithm.md section 8.1) ---
 //
-// The scene's reach from the camera: the power of two at or above the
-// distance from the camera to the farthest corner of the scene's bounds
-// (the frame uniforms carry it as normal_depth_scale = 2^15 / reach). The
-// coarsest cascade's side is the reach; each finer one halves it. Every
-// factor is a power of two, so cell sizes are exact and a scene scaled by a
-// power of two makes the same grid.
-float lpv_cell_size(int c) {
-    float reach = 32768.0 / u.normal_depth_scale;
-    return reach * exp2(float(c - (LPV_CASCADES - 1))) / float(LPV_SIZE);
+// Fitted to the scene's bounds (u.scene_min, u.scene_max) and the camera.
+// The coarsest cascade holds the scene: its cell is the smallest power of
+// two h with (N - 3) h >= the bounds' largest side, so that it spans them
+// with a cell to spare on each side (two below, one above, as the snap
+// falls). Each finer cascade halves the cell. Powers of two keep every
+// product and quotient exact (the host, every shader and every stage place
+// alike) and a scene scaled by a power of two makes the same grids.
+//
+// The coarsest cascade's cell, as an exponent: the smallest k with
+// (N - 3) 2^k >= the largest side (0 for an empty scene). log2 is only
+// approximate; the exact comparisons settle k.
+int lpv_top_exponent() {
+    vec3 e = u.scene_max - u.scene_min;
+    float side = max(max(e.x, e.y), e.z);
+    if (!(side > 0.0)) return 0;
+    float room = float(LPV_SIZE - 3);
+    int k = int(ceil(log2(side / room)));
+    if (ldexp(room, k - 1) >= side) k -= 1;
+    if (ldexp(room, k) < side) k += 1;
+    return k;
 }
 
-// Cascade c's first cell, in whole cells of its size from the render origin:
-// its centre lies 3/8 of its side ahead of the camera (an eighth of it behind
-// the camera), snapped to whole cells, so the grid does not swim as the
-// camera moves. `precise`: every shader computes the same cells.
+// Cascade c's cell exponent: the coarsest's, halved per cascade finer.
+int lpv_exponent(int c) {
+    return lpv_top_exponent() + c - (LPV_CASCADES - 1);
+}
+
+float lpv_cell_size(int c) {
+    return ldexp(1.0, lpv_exponent(c));
+}
+
+// Cascade c's first cell, in whole cells from the scene's min corner. Its
+// centre aims LPV_AHEAD of its side ahead of the camera, moved (per axis)
+// as little as keeps the cascade inside the bounds widened by a cell, or
+// at their middle where it is wider than that; then snapped to whole cells
+// of a lattice fixed to the scene, so the grid does not swim as the camera
+// moves. A camera outside the bounds gets the cascades on the scene's side
+// nearest it. `precise`: every shader computes the same cells.
 ivec3 lpv_origin(int c) {
-    float h = lpv_cell_size(c);
-    precise vec3 centre = u.camera_position + u.camera_forward * (0.375 * float(LPV_SIZE) * h);
-    return ivec3(floor(centre / h)) - ivec3(LPV_SIZE / 2);
+    int k = lpv_exponent(c);
+    float h = ldexp(1.0, k);
+    float side = float(LPV_SIZE) * h;
+    precise vec3 aim = u.camera_position + u.camera_forward * (LPV_AHEAD * side);
+    precise vec3 lo = u.scene_min - h + 0.5 * side;
+    precise vec3 hi = u.scene_max + h - 0.5 * side;
+    precise vec3 middle = 0.5 * (u.scene_min + u.scene_max);
+    vec3 centre = mix(min(max(aim, lo), hi), middle, lessThan(hi, lo));
+    precise vec3 cells = (centre - u.scene_min) * ldexp(1.0, -k);
+    return ivec3(floor(cells)) - ivec3(LPV_SIZE / 2);
 }
 
 // Point p in cascade c's cell coordinates: cell i spans [i, i + 1).
 vec3 lpv_grid_position(int c, vec3 p) {
-    return p / lpv_cell_size(c) - vec3(lpv_origin(c));
+    precise vec3 g = (p - u.scene_min) * ldexp(1.0, -lpv_exponent(c)) - vec3(lpv_origin(c));
+    return g;
 }
 
 bool lpv_inside(ivec3 cell) {

@@ -48,6 +48,8 @@ pub fn frame_uniforms(
         cube_face: v.face.unwrap_or(0) as i32,
         light_index: v.light as i32,
         cube_view_proj: v.cube.map(|m| m.to_cols_array_2d()),
+        scene_min: bounds.0.to_array(),
+        scene_max: bounds.1.to_array(),
         ..Default::default()
     }
 }

@@ -216,9 +216,10 @@ fn fill(gpu: &Gpu, cmd: vk::CommandBuffer, image: &Image, value: [f32; 4]) {
     barrier::transition(gpu, cmd, &[image], Use::COLOR_ATTACHMENT, Use::READ_ONLY);
 }
 
-/// The camera of the single-VPL tests: at the origin looking down -z, the
-/// scene's reach 8 m, so that with 32 cells the cascades have cells of
-/// 1/16, 1/8 and 1/4 m.
+/// The camera of the single-VPL tests: at the origin looking down -z, in
+/// a scene 6 m wide around it (`SCENE_HALF`), so that with 32 cells the
+/// cascades have cells of 1/16, 1/8 and 1/4 m (29 / 4 m is the smallest
+/// power-of-two multiple of 29 cells at or above 6 m).
 pub fn origin_camera(forward: Vec3) -> FrameUniforms {
     let camera = Camera::look_at(Vec3::ZERO, forward, Vec3::Y, 60f32.to_radians(), 0.05);
     FrameUniforms {
@@ -226,9 +227,14 @@ pub fn origin_camera(forward: Vec3) -> FrameUniforms {
         camera_position: [0.0; 3],
         camera_forward: forward.to_array(),
         normal_depth_scale: 32768.0 / 8.0,
+        scene_min: [-SCENE_HALF; 3],
+        scene_max: [SCENE_HALF; 3],
         ..Default::default()
     }
 }
+
+/// Half the side of the scene `origin_camera` sees.
+pub const SCENE_HALF: f32 = 3.0;
 
 /// The VPL whose injection point (half a finest cell along its normal)
 /// is the centre of cell `cell` of cascade 0.

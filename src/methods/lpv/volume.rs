@@ -134,6 +134,7 @@ impl Lpv {
         let spec = [
             Spec::int("LPV_SIZE", n as i32),
             Spec::int("LPV_CASCADES", c as i32),
+            Spec::float("LPV_AHEAD", super::grid::AHEAD),
         ];
         let inject = PassPipeline::graphics(
             gpu,
@@ -152,6 +153,7 @@ impl Lpv {
                 specialization: &[
                     spec[0],
                     spec[1],
+                    spec[2],
                     Spec::int("LPV_LEVEL", layout.vpl_level as i32),
                 ],
                 ..Default::default()
@@ -176,6 +178,7 @@ impl Lpv {
                     specialization: &[
                         spec[0],
                         spec[1],
+                        spec[2],
                         Spec::bool("FROM_GBUFFER", from_gbuffer),
                         Spec::int("LPV_LEVEL", layout.vpl_level as i32),
                         Spec::int("LPV_STRIDE", layout.gbuffer_stride as i32),
@@ -202,7 +205,12 @@ impl Lpv {
             "lpv/propagate.comp",
             &[variant(0), variant(1)],
             0,
-            &[spec[0], spec[1], Spec::bool("OCCLUSION", layout.occlusion)],
+            &[
+                spec[0],
+                spec[1],
+                spec[2],
+                Spec::bool("OCCLUSION", layout.occlusion),
+            ],
         )?;
         let lookup = PassPipeline::graphics(
             gpu,
