@@ -9,6 +9,7 @@ pub mod charts;
 pub mod files;
 pub mod flip;
 pub mod gallery;
+pub mod headline;
 mod measure;
 pub mod metrics;
 pub mod publish;

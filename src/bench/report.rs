@@ -95,8 +95,8 @@ truth of each frame).{}\n\n",
     }
     md += &format!("![gallery]({images}{})\n\n", files::GALLERY);
     md += "## At each method's default, against the truth\n\n";
-    md += &super::publish::headline(plan, o);
-    md += &super::publish::balance_section(o);
+    md += &super::headline::headline(plan, o);
+    md += &super::headline::balance_section(o);
     md += "\n";
     md += &model_errors(plan, o);
     md += &flicker_table(plan, o);
