@@ -96,11 +96,7 @@ alone.\n\n",
             );
             continue;
         }
-        // Sponza as papers show it: a high sun on the atrium floor.
-        let described = match name {
-            "sponza" => "assets/archive/sponza-noon.scene.json".to_owned(),
-            _ => format!("assets/archive/{name}.scene.json"),
-        };
+        let described = format!("assets/archive/{name}.scene.json");
         let mut args = vec!["--scene", described.as_str()];
         args.extend_from_slice(&SIZE);
         let shot = render(&root, &args, &format!("docs/gallery/{name}.png"))?;
