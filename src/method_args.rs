@@ -57,6 +57,8 @@ fn heading(p: &dyn AnyParam) -> String {
         Some("Regular VPLs")
     } else if has(rsm_tree::PARAMS) {
         Some("RSM quadtree")
+    } else if p.name() == crate::bounces::BOUNCES.name {
+        Some("Bounces")
     } else {
         None
     };
@@ -67,10 +69,11 @@ fn heading(p: &dyn AnyParam) -> String {
     }
 }
 
-/// Whether `-h` shows `p`: a method's main knob, or the visibility choice;
-/// `--help` shows every parameter, the ablation knobs too.
+/// Whether `-h` shows `p`: a method's main knob, the visibility choice or
+/// the bounces; `--help` shows every parameter, the ablation knobs too.
 pub fn in_short_help(p: &dyn AnyParam) -> bool {
     p.name() == visibility::VISIBILITY.name
+        || p.name() == crate::bounces::BOUNCES.name
         || REGISTRY
             .iter()
             .any(|d| d.main_param().is_some_and(|q| q.name() == p.name()))
