@@ -51,7 +51,7 @@ fn compare_direct_layers(scene: &Scene) {
     let shadows = ShadowMaps::new(
         &rendered.light_views,
         rendered.origin,
-        settings.shadow_size(),
+        1024,
         settings.pcf_radius,
     );
     let mask = truth_mask(raster, &traced.direct, &shadows);

@@ -22,7 +22,6 @@ use crate::methods::{Descriptor, IndirectMethod};
 use crate::passes::light_sum::LightSumPass;
 use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::{self, RsmTreePass};
-use crate::passes::shadow::ShadowPass;
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::scene::{FrameState, LightKind, Scene};
 use crate::settings::RenderSettings;
@@ -100,7 +99,6 @@ pub struct Renderer<'g> {
     method: Box<dyn IndirectMethod>,
     rsm: ScenePass,
     gbuffer: ScenePass,
-    shadow: ShadowPass,
     direct: FullscreenPass,
     rsm_tree: RsmTreePass,
     composite: FullscreenPass,
@@ -137,12 +135,7 @@ impl<'g> Renderer<'g> {
             objects: &object_bounds,
             size: (settings.width, settings.height),
         };
-        let views = all_views(
-            &state,
-            &fitting,
-            settings.rsm_resolution,
-            settings.sun_shadow_fit(),
-        );
+        let views = all_views(&state, &fitting, settings.rsm_resolution);
         // The texture arrays' memory is checked with the rest before anything
         // is allocated; `SceneGpu::new` makes the same plan again (it is
         // cheap: sizes only).
@@ -188,8 +181,7 @@ impl<'g> Renderer<'g> {
         let method = crate::methods::create(&setup)?;
         let rsm = rsm::new(&setup)?;
         let gbuffer = gbuffer::new(&setup)?;
-        let shadow = ShadowPass::new(&setup)?;
-        let direct = direct_light::new(&setup, &shadow.depth)?;
+        let direct = direct_light::new(&setup)?;
         let rsm_tree = RsmTreePass::new(&setup)?;
         let composite = composite::new(&setup)?;
         let tonemap = tonemap::new(&setup)?;
@@ -246,7 +238,6 @@ impl<'g> Renderer<'g> {
             method,
             rsm,
             gbuffer,
-            shadow,
             direct,
             rsm_tree,
             composite,
@@ -288,12 +279,7 @@ impl<'g> Renderer<'g> {
             objects: &self.object_bounds,
             size: (self.settings.width, self.settings.height),
         };
-        self.views = all_views(
-            &self.state,
-            &fitting,
-            self.settings.rsm_resolution,
-            self.settings.sun_shadow_fit(),
-        );
+        self.views = all_views(&self.state, &fitting, self.settings.rsm_resolution);
         Ok(())
     }
 
