@@ -185,3 +185,47 @@ fn the_reference_names_shader_switches_rather_than_quoting_their_values() {
         "docs/algorithm.md quotes the values of shader switches (name them instead): {quoted:?}"
     );
 }
+
+/// The defaults `isr` ships are the subject's best balance in the published
+/// run (one definition, `bench::headline::best_balance`): `isr render` with
+/// no option renders the setting docs/results.md names.
+#[test]
+fn the_default_is_the_best_balance_of_the_published_run() {
+    let json: serde_json::Value =
+        serde_json::from_str(&read("docs/results/results.json")).expect("results.json");
+    let rows: Vec<isr::bench::rows::Row> =
+        serde_json::from_value(json["rows"].clone()).expect("the published rows");
+    let subject_key = || isr::methods::SUBJECT;
+    let subject = isr::methods::SUBJECT.name();
+    let best = isr::bench::headline::best_balance(&rows, subject).expect("a best balance");
+    let row = rows
+        .iter()
+        .find(|r| r.method == subject && r.label == best.label && r.visibility == best.visibility)
+        .unwrap();
+    let defaults = isr::settings::RenderSettings::default();
+    assert_eq!(
+        defaults.method,
+        isr::methods::SUBJECT,
+        "the default method is the subject"
+    );
+    // The knobs the rule chooses: the method's main one and the visibility
+    // (others, such as the levels, derive from the image's size, which the
+    // bench's differs from a render's).
+    let descriptor = isr::methods::find(subject_key()).expect("the subject is registered");
+    let main = descriptor
+        .main_param()
+        .expect("the subject has a main knob");
+    let visibility: &dyn isr::settings::params::AnyParam = &isr::visibility::VISIBILITY;
+    for p in [main, visibility] {
+        let ours = p.text_in(&defaults);
+        let published = row.params.get(p.name()).expect("the row names the knob");
+        assert_eq!(
+            &ours,
+            published,
+            "--{}: the default is {ours}, the best balance of docs/results.md {published} ({} {})",
+            p.name(),
+            best.label,
+            best.visibility
+        );
+    }
+}

@@ -97,6 +97,7 @@ every_method! {
     isr_fails_at_every_pipeline: "isr",
     hisr_fails_at_every_pipeline: "hisr",
     lpv_fails_at_every_pipeline: "lpv",
+    vct_fails_at_every_pipeline: "vct",
     reference_fails_at_every_pipeline: "reference",
 }
 

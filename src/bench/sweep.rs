@@ -110,6 +110,6 @@ mod tests {
             .iter()
             .map(|c| c.label(&base))
             .collect();
-        assert_eq!(labels, ["tau 0.2, depth 7", "tau 0.02, depth 7"]);
+        assert_eq!(labels, ["tau 0.2, depth 7", "tau 0.05, depth 7"]);
     }
 }

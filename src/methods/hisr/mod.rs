@@ -61,7 +61,7 @@ pub const TAU: Param<f32> = Param {
            could exceed tau * I (absolute)",
     // The best balance (docs/results.md, "Best balance"): with the grid, the
     // cheapest tau within 1.25x of the lowest error against the truth.
-    default: DefaultValue::Fixed(0.02),
+    default: DefaultValue::Fixed(0.05),
     range: Range::open(0.0, 1.0),
 };
 
@@ -289,7 +289,7 @@ fn sweep(rsm: u32, quick: bool) -> Vec<Params> {
     };
     // The accurate end, at the default depth (single RSM texels up to RSM
     // 256), where tau alone sets the error: about tau / 4 to tau / 1.6
-    // against the dense gather (docs/algorithm.md 4.3). 0.02 is the default.
+    // against the dense gather (docs/algorithm.md 4.3). 0.05 is the default.
     for t in [0.5, 0.2, 0.1, 0.05, 0.02, 0.005] {
         add(tau(t));
     }
