@@ -4,8 +4,6 @@
 //! reference (the box's indirect energy); the leak through a wall thinner
 //! than a cell, measured and bounded; every light type validation-clean.
 mod common;
-#[path = "vct/scenes.rs"]
-mod scenes;
 
 use common::*;
 use glam::{DVec3, Vec3};
@@ -34,10 +32,10 @@ fn sum_where(r: &Readback, values: &[[f32; 4]], keep: impl Fn(usize) -> bool) ->
 #[test]
 fn inside_a_closed_sphere_the_first_bounce_is_near_uniform() {
     let rho = 0.5;
-    let (scene, area) = scenes::sphere(Vec3::splat(rho as f32), 3);
+    let (scene, area) = sphere::sphere(Vec3::splat(rho as f32), 3);
     let gpu = gpu();
     let r = render(&gpu, &scene, &vct(64, 128, 64), 1).readback;
-    let expected = rho * scenes::spot_power() / area;
+    let expected = rho * sphere::spot_power() / area;
     let mut worst: f64 = 0.0;
     for (group, on_cap) in [("lit cap", true), ("unlit wall", false)] {
         let pick = |i: usize| (r.direct[i][0] > 0.0) == on_cap;
