@@ -9,64 +9,24 @@
 use super::{propagations, CELLS, CELL_BYTES, STEP, VPLS};
 use crate::bounces::{Bounces, BOUNCES};
 use crate::frame::{FrameContext, Setup};
-use crate::passes::INDIRECT_COMPUTE;
+use crate::passes::{ComputePass, INDIRECT_COMPUTE};
 use crate::regular_vpls::RegularVpls;
 use crate::visibility;
 use crate::vk::barrier::{self, Use};
-use crate::vk::pipeline::{Binding, DescriptorSet, Pipeline, Spec};
+use crate::vk::pipeline::{Binding, Spec};
 use crate::vk::profiler::Profiler;
 use crate::vk::{Buffer, Gpu};
 use anyhow::{Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-/// One compute pipeline and its sets (set 1), one per variant.
-struct Stage {
-    pipeline: Pipeline,
-    sets: Vec<DescriptorSet>,
-}
-
-impl Stage {
-    fn new(
-        setup: &Setup,
-        name: &str,
-        shader: &str,
-        variants: &[Vec<Binding>],
-        specialization: &[Spec],
-    ) -> Result<Self> {
-        let sets = variants
-            .iter()
-            .map(|b| DescriptorSet::new(setup.gpu, name, b))
-            .collect::<Result<Vec<_>>>()?;
-        let pipeline = Pipeline::compute(
-            setup.gpu,
-            name,
-            shader,
-            &[setup.frame, &sets[0]],
-            0,
-            specialization,
-        )?;
-        Ok(Self { pipeline, sets })
-    }
-
-    fn dispatch(&self, ctx: &FrameContext, variant: usize, groups: (u32, u32)) {
-        self.pipeline.bind(
-            ctx.gpu,
-            ctx.cmd,
-            vk::PipelineBindPoint::COMPUTE,
-            &[ctx.frame_set, self.sets[variant].set],
-        );
-        unsafe { ctx.gpu.device.cmd_dispatch(ctx.cmd, groups.0, groups.1, 1) };
-    }
-}
-
 /// The bounce passes of a run with `--bounces` above 1.
 pub struct BouncePass {
-    cells: Stage,
-    transfer: Stage,
-    propagate: Stage,
-    gather: Stage,
-    add: Stage,
+    cells: ComputePass,
+    transfer: ComputePass,
+    propagate: ComputePass,
+    gather: ComputePass,
+    add: ComputePass,
     propagations: u32,
     /// The receivers' grid: pixels / STEP, rounded up.
     low: (u32, u32),
@@ -112,7 +72,7 @@ impl BouncePass {
         let count = (VPLS as u64).min(r * r) as u32;
         let vpls = RegularVpls::with_count(s, count).specialization(s);
         let nearest = setup.samplers.nearest;
-        let cells_pass = Stage::new(
+        let cells_pass = ComputePass::new(
             setup,
             "bounce-cells",
             "bounce/cells.comp",
@@ -125,9 +85,10 @@ impl BouncePass {
                 Binding::sampled("rsm_normal", t.rsm_normal.view, nearest),
                 Binding::sampled("rsm_flux", t.rsm_flux.view, nearest),
             ]],
+            0,
             &[&vis[..], &vpls[..]].concat(),
         )?;
-        let transfer_pass = Stage::new(
+        let transfer_pass = ComputePass::new(
             setup,
             "bounce-transfer",
             "bounce/transfer.comp",
@@ -135,6 +96,7 @@ impl BouncePass {
                 Binding::storage("BounceCells", &cells),
                 Binding::storage("BounceTransfer", &transfer),
             ]],
+            0,
             &vis,
         )?;
         let ping_pong = |from, to| {
@@ -147,11 +109,12 @@ impl BouncePass {
                 Binding::storage("BounceState", &state),
             ]
         };
-        let propagate = Stage::new(
+        let propagate = ComputePass::new(
             setup,
             "bounce-propagate",
             "bounce/propagate.comp",
             &[ping_pong(&power_a, &power_b), ping_pong(&power_b, &power_a)],
+            0,
             &[
                 step,
                 Spec::bool("BOUNCE_INFINITE", BOUNCES.get(s) == Bounces::Infinite),
@@ -176,11 +139,12 @@ impl BouncePass {
             Binding::storage("BouncePowerSum", &power_sum),
             Binding::storage("BounceReceived", &received),
         ]);
-        let gather = Stage::new(
+        let gather = ComputePass::new(
             setup,
             "bounce-gather",
             "bounce/gather.comp",
             &[gather_bindings],
+            0,
             &vis,
         )?;
         let mut add_bindings = vec![];
@@ -189,11 +153,12 @@ impl BouncePass {
             Binding::storage("BounceReceived", &received),
             Binding::storage_image("indirect", t.indirect.view),
         ]);
-        let add = Stage::new(
+        let add = ComputePass::new(
             setup,
             "bounce-add",
             "bounce/add.comp",
             &[add_bindings],
+            0,
             &[step],
         )?;
         Ok(Some(Self {
@@ -220,7 +185,7 @@ impl BouncePass {
             // The previous view's or frame's readers of every buffer before
             // they are written again.
             barrier::memory(gpu, cmd, compute, rw, compute, rw);
-            self.cells.dispatch(ctx, 0, (CELLS, 1));
+            self.cells.dispatch_groups(ctx, 0, &[], (CELLS, 1));
             barrier::compute_to_compute(gpu, cmd);
         });
         // Two bounces reach receivers from the cells' first: no transfer.
@@ -228,18 +193,20 @@ impl BouncePass {
             self.record_propagation(ctx, profiler);
         }
         profiler.pass(gpu, cmd, "bounce-gather", INDIRECT_COMPUTE, || {
-            self.gather
-                .dispatch(ctx, 0, (self.low.0.div_ceil(8), self.low.1.div_ceil(8)));
+            self.gather.dispatch_groups(
+                ctx,
+                0,
+                &[],
+                (self.low.0.div_ceil(8), self.low.1.div_ceil(8)),
+            );
             barrier::compute_to_compute(gpu, cmd);
         });
         profiler.pass(gpu, cmd, "bounce-add", INDIRECT_COMPUTE, || {
             let indirect = &ctx.targets.indirect;
             barrier::transition(gpu, cmd, &[indirect], Use::READ_ONLY, Use::COMPUTE_STORAGE);
-            self.add.dispatch(
-                ctx,
-                0,
-                (self.extent.0.div_ceil(8), self.extent.1.div_ceil(8)),
-            );
+            let (width, height) = self.extent;
+            self.add
+                .dispatch(ctx, 0, &[], vk::Extent2D { width, height });
             barrier::transition(gpu, cmd, &[indirect], Use::COMPUTE_STORAGE, Use::READ_ONLY);
         });
     }
@@ -250,7 +217,8 @@ impl BouncePass {
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
         profiler.pass(gpu, cmd, "bounce-transfer", INDIRECT_COMPUTE, || {
-            self.transfer.dispatch(ctx, 0, (CELLS / 8, CELLS / 8));
+            self.transfer
+                .dispatch_groups(ctx, 0, &[], (CELLS / 8, CELLS / 8));
             barrier::compute_to_compute(gpu, cmd);
         });
         profiler.pass(gpu, cmd, "bounce-propagate", INDIRECT_COMPUTE, || {
@@ -264,7 +232,8 @@ impl BouncePass {
                 (compute, rw),
             );
             for k in 0..self.propagations {
-                self.propagate.dispatch(ctx, (k % 2) as usize, (1, 1));
+                self.propagate
+                    .dispatch_groups(ctx, (k % 2) as usize, &[], (1, 1));
                 barrier::compute_to_compute(gpu, cmd);
             }
         });

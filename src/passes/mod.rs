@@ -433,6 +433,18 @@ impl ComputePass {
 
     /// Dispatches 8x8 workgroups covering `extent` with set `variant`.
     pub fn dispatch(&self, ctx: &FrameContext, variant: usize, push: &[u8], extent: vk::Extent2D) {
+        let groups = (extent.width.div_ceil(8), extent.height.div_ceil(8));
+        self.dispatch_groups(ctx, variant, push, groups);
+    }
+
+    /// Dispatches `groups` workgroups (x, y) with set `variant`.
+    pub fn dispatch_groups(
+        &self,
+        ctx: &FrameContext,
+        variant: usize,
+        push: &[u8],
+        groups: (u32, u32),
+    ) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let d = &gpu.device;
         self.pipeline.bind(
@@ -451,7 +463,7 @@ impl ComputePass {
                     push,
                 );
             }
-            d.cmd_dispatch(cmd, extent.width.div_ceil(8), extent.height.div_ceil(8), 1);
+            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
         }
     }
 }
