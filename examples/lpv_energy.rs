@@ -116,6 +116,7 @@ fn load(file: &std::path::Path, image: &Readback) -> Option<Truth> {
         },
         spp: words[0] as u32,
         noise: words[1] as f64,
+        noises: vec![words[1] as f64],
     })
 }
 

@@ -8,6 +8,7 @@ use super::rows::{self, Row};
 use super::sweep::Config;
 use super::{flip, frame_time, gallery, metrics, truth_cache, Plan, SceneSpec};
 use super::{visibility, REFERENCE, REFERENCE_LABEL};
+use crate::bounces::Bounces;
 use crate::readback::Readback;
 use crate::renderer::{FrameStats, Renderer};
 use crate::scene::Scene;
@@ -26,14 +27,46 @@ struct RefFrame {
     display: Vec<u8>,
 }
 
-/// One frame of the path-traced truth: its indirect image, the pixels it is
-/// compared on, and what the reference rows report of it.
-struct TruthFrame {
+/// One frame of the path-traced truth: its indirect image of the run's
+/// bounces, the pixels it is compared on, and what the reference rows
+/// report of it; with the bounces axis (`bounce_axis`), its images of 1, 2,
+/// 3 and every bounce.
+pub(super) struct TruthFrame {
     indirect: Vec<[f32; 4]>,
-    mask: Vec<bool>,
+    pub(super) mask: Vec<bool>,
     spp: f64,
     noise: f64,
     left_out: f64,
+    pub(super) axis: Vec<Vec<[f32; 4]>>,
+}
+
+impl TruthFrame {
+    /// The frame of truth `t` whose rows are of `bounces` (`t`'s own, or
+    /// fewer its layers hold: `Plan::truth_bounces`).
+    pub(super) fn new(t: super::truth::Truth, bounces: Bounces) -> Result<TruthFrame> {
+        let (indirect, noise) = t.of(bounces).with_context(|| {
+            format!(
+                "the truth of {} holds no truth of {}",
+                t.bounces.words(),
+                bounces.words()
+            )
+        })?;
+        let axis = match t.bounces {
+            Bounces::Infinite => super::bounce_axis::SUBJECT_BOUNCES
+                .iter()
+                .filter_map(|&b| t.of(b).map(|(x, _)| x))
+                .collect(),
+            _ => vec![],
+        };
+        Ok(TruthFrame {
+            spp: t.spp as f64,
+            noise,
+            left_out: t.mask.left_out(),
+            indirect,
+            mask: t.mask.mask,
+            axis,
+        })
+    }
 }
 
 /// The total the GPU allocator has handed out, in bytes.
@@ -107,23 +140,28 @@ fn image_frames(plan: &Plan) -> u32 {
 }
 
 /// Renders what `passes` of scene `spec` (`Plan::passes` with what each
-/// needs) still need. Each frame's truth is traced, or read from its cache,
-/// once, by the first pass that measures, and serves every pass after it.
+/// needs) still need, then the bounces axis's `axis` (of scene plan
+/// `plan`; `bounce_axis::pending`). Each frame's truth is traced, or read
+/// from its cache, once, by the first pass that measures, and serves every
+/// pass after it.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn run_scene(
     gpu: &Gpu,
+    plan: &Plan,
     spec: &SceneSpec,
     scene: &Scene,
     passes: &[(Plan, Pending)],
+    axis: &[Vec<super::bounce_axis::Point>],
     journal: &Path,
     bar: &indicatif::ProgressBar,
 ) -> Result<()> {
     let frames = passes.iter().map(|(p, _)| p.frames).max().unwrap_or(0);
-    let mut truths: Vec<Option<TruthFrame>> = (0..frames).map(|_| None).collect();
+    let mut truths: Vec<Option<TruthFrame>> = (0..frames.max(plan.frames)).map(|_| None).collect();
     for (plan, work) in passes {
         let refs = reference(plan, gpu, spec, scene, work, &mut truths, journal, bar)?;
         points(plan, gpu, spec, scene, work, &refs, &truths, journal, bar)?;
     }
-    Ok(())
+    super::bounce_axis::run(plan, gpu, spec, scene, axis, &mut truths, journal, bar)
 }
 
 /// The dense reference of pass `plan`, every frame it needs, with the truth
@@ -169,13 +207,7 @@ fn reference(
                 None => {
                     let t = truth_cache::frame_truth(plan, spec, k, &posed, &r, &out, bar)?;
                     bar.inc(1);
-                    slot.insert(TruthFrame {
-                        spp: t.spp as f64,
-                        noise: t.noise,
-                        left_out: t.mask.left_out(),
-                        indirect: t.image.indirect,
-                        mask: t.mask.mask,
-                    })
+                    slot.insert(TruthFrame::new(t, plan.bounces())?)
                 }
             };
             // Only the reference's row without visibility keeps the floor:
@@ -391,7 +423,12 @@ fn parameter_values(s: &RenderSettings) -> std::collections::BTreeMap<String, St
 }
 
 /// A row with the settings and the timings filled in; errors zero.
-fn timing_row(plan: &Plan, spec: &SceneSpec, s: &RenderSettings, stats: &FrameStats) -> Row {
+pub(super) fn timing_row(
+    plan: &Plan,
+    spec: &SceneSpec,
+    s: &RenderSettings,
+    stats: &FrameStats,
+) -> Row {
     let report = crate::report::build(
         &crate::report::RunInfo {
             device: "",

@@ -4,8 +4,10 @@
 //! `report.md` into one folder. Rows are journalled to `rows.jsonl` as they
 //! finish, so an interrupted run resumes where it stopped.
 
+pub mod bounce_axis;
 pub mod bounces;
 pub mod charts;
+mod date;
 pub mod files;
 pub mod flip;
 pub mod gallery;
@@ -22,6 +24,7 @@ pub mod truth;
 mod truth_cache;
 pub mod visibility;
 
+use crate::bounces::BOUNCES;
 use crate::scene::Scene;
 use crate::settings::{Method, RenderSettings};
 use crate::visibility::Visibility;
@@ -132,6 +135,9 @@ pub struct Plan {
     /// The visibility axis (`--visibility`; `visibility::parse`); a pass's
     /// plan (`Plan::passes`): its one visibility.
     pub visibilities: Vec<Visibility>,
+    /// Whether the run measures the bounces axis (`bounce_axis::on`), and
+    /// so traces the truth of every bounce (`Plan::truth_bounces`).
+    pub bounce_axis: bool,
 }
 
 /// A scene of the run: its name, how it is made, its animation window, and
@@ -285,6 +291,7 @@ impl BenchArgs {
         if let Some(w) = bounces::warning(&base, &methods).filter(|_| truth_noise > 0.0) {
             eprintln!("{w}");
         }
+        let bounce_axis = bounce_axis::on(q, truth_noise > 0.0, BOUNCES.get(&base), &methods);
         Ok(Plan {
             scenes: specs,
             methods,
@@ -296,6 +303,7 @@ impl BenchArgs {
             device: self.device,
             truth_noise: (truth_noise > 0.0).then_some(truth_noise),
             visibilities,
+            bounce_axis,
         })
     }
 }
@@ -370,6 +378,8 @@ const REFERENCE: Method = crate::methods::REFERENCE;
 /// What a finished run returns (the rows of this plan, in order).
 pub struct Outcome {
     pub rows: Vec<Row>,
+    /// The rows of the bounces axis (`bounce_axis`), in its order.
+    pub bounce_rows: Vec<Row>,
     pub device: String,
     pub driver: String,
     /// The command that ran (`isr bench ...`), and the day it finished
@@ -462,7 +472,13 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     crate::bench::charts::register_font();
     // Work units: one per frame rendered (each pass's reference and every
     // pending point) and per frame traced (the truth, once per scene).
-    let mut pending: Vec<(SceneSpec, Vec<(Plan, Pending)>)> = vec![];
+    #[allow(clippy::type_complexity)]
+    let mut pending: Vec<(
+        SceneSpec,
+        Plan,
+        Vec<(Plan, Pending)>,
+        Vec<Vec<bounce_axis::Point>>,
+    )> = vec![];
     let mut units = 0u64;
     for s in &plan.scenes {
         let scene_plan = plan.for_scene(s);
@@ -471,19 +487,22 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
             .into_iter()
             .filter_map(|p| Pending::of(&p, s, &done).map(|w| (p, w)))
             .collect();
-        if passes.is_empty() {
+        let axis = bounce_axis::pending(&scene_plan, s, &done);
+        if passes.is_empty() && axis.is_empty() {
             continue;
         }
-        if scene_plan.truth_noise.is_some() && passes.iter().any(|(_, w)| w.measures()) {
+        let measures = passes.iter().any(|(_, w)| w.measures()) || !axis.is_empty();
+        if scene_plan.truth_noise.is_some() && measures {
             units += scene_plan.frames as u64;
         }
         units += passes.iter().map(|(p, w)| w.frames(p)).sum::<u64>();
-        pending.push((s.clone(), passes));
+        units += axis.iter().map(|m| m.len() as u64).sum::<u64>() * scene_plan.frames as u64;
+        pending.push((s.clone(), scene_plan, passes, axis));
     }
     let bar = crate::progress::bar(units, "frames");
-    for (spec, passes) in &pending {
+    for (spec, scene_plan, passes, axis) in &pending {
         let scene = spec.load()?;
-        run_scene(&gpu, spec, &scene, passes, &journal, &bar)?;
+        run_scene(&gpu, scene_plan, spec, &scene, passes, axis, &journal, &bar)?;
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;
@@ -496,12 +515,17 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
             Some(Row { visibility, ..r })
         })
         .collect();
+    let bounce_rows: Vec<Row> = bounce_axis::keys(plan)
+        .into_iter()
+        .filter_map(|k| all.iter().rev().find(|r| r.key == k).cloned())
+        .collect();
     let outcome = Outcome {
         rows,
+        bounce_rows,
         device: gpu.info.name.clone(),
         driver: gpu.info.driver.clone(),
         command: command_line(),
-        date: today(),
+        date: date::today(),
     };
     report::write_all(plan, &outcome)?;
     Ok(outcome)
@@ -542,44 +566,7 @@ fn command_line() -> String {
     format!("isr {}", args.join(" "))
 }
 
-/// Today's date (UTC) as YYYY-MM-DD, from the system clock.
-fn today() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
-    format!("{y:04}-{m:02}-{d:02}")
-}
-
-/// The proleptic Gregorian date of `days` since 1970-01-01 (Howard
-/// Hinnant's days-to-civil algorithm).
-fn civil_from_days(days: i64) -> (i64, u32, u32) {
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    (yoe + era * 400 + (m <= 2) as i64, m, d)
-}
-
 /// Animation time of frame `k`.
 fn frame_time(spec: &SceneSpec, k: u32) -> f32 {
     spec.start + k as f32 / spec.fps
-}
-
-#[cfg(test)]
-mod tests {
-    use super::civil_from_days;
-
-    #[test]
-    fn days_become_dates() {
-        assert_eq!(civil_from_days(0), (1970, 1, 1));
-        assert_eq!(civil_from_days(59), (1970, 3, 1));
-        // 2000-02-29 (a leap day of a year divisible by 400) and 2026-12-06.
-        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
-        assert_eq!(civil_from_days(20_793), (2026, 12, 6));
-    }
 }

@@ -101,6 +101,7 @@ truth of each frame).{}\n\n",
     md += &model_errors(plan, o);
     md += &flicker_table(plan, o);
     md += &super::visibility::report_table(plan, &o.rows);
+    md += &super::bounce_axis::report(&o.bounce_rows);
     md += "\n## Ratios\n\nEach from the rows of one visibility.\n\n\
 | scene | visibility | measure | value | detail |\n| --- | --- | --- | ---: | --- |\n";
     for r in ratios {
@@ -232,6 +233,7 @@ pub fn write_all(plan: &Plan, o: &Outcome) -> Result<()> {
         "bounces": super::bounces::of_rows(&o.rows),
         "ratios": ratios,
         "rows": o.rows,
+        "bounce_axis": o.bounce_rows,
     });
     crate::output::write_text(
         &dir.join(files::RESULTS_JSON),

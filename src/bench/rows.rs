@@ -89,6 +89,18 @@ pub struct TruthErrors {
     /// the VPL model (its texel-sized VPLs alone).
     #[serde(default)]
     pub floor: Option<f64>,
+    /// A row of the bounces axis (`bounce_axis`), whose
+    /// `rel_rmse_indirect` is against the truth of every bounce: its error
+    /// against the truth of its own bounces; the light its bounces 2..N add
+    /// (`I_N - I_1`) over what they add in the truth (`T_N - T_1`), summed
+    /// over the mask and the frames (1: as much; none for one bounce); and
+    /// the truth's share of the indirect light of bounces 1, 2, 3 and 4 on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub same_bounces: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extra_light: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shares: Option<Vec<f64>>,
 }
 
 /// What [`read_journal`] found: the rows, and the lines it skipped.

@@ -247,13 +247,32 @@ pub const MAX_SPP: u32 = 16384;
 
 /// One frame's path-traced truth: its image (the sum of both halves, its
 /// layers by bounce included), the pixels it is compared on, its bounces,
-/// samples per pixel and measured noise.
+/// samples per pixel and measured noise (of its whole indirect image; and
+/// of the sum of its first n layers, `noises[n - 1]`).
 pub struct Truth {
     pub image: Readback,
     pub bounces: Bounces,
     pub mask: TruthMask,
     pub spp: u32,
     pub noise: f64,
+    pub noises: Vec<f64>,
+}
+
+/// The sum of the first `n` layers by bounce of `r` (its indirect image
+/// where `n` is all of them): the image of `n` bounces.
+pub fn first_layers(r: &Readback, n: usize) -> Vec<[f32; 4]> {
+    if n >= r.bounces.len() {
+        return r.indirect.clone();
+    }
+    let mut out = vec![[0.0, 0.0, 0.0, 1.0]; r.indirect.len()];
+    for layer in &r.bounces[..n] {
+        for (o, v) in out.iter_mut().zip(layer) {
+            for c in 0..3 {
+                o[c] += v[c];
+            }
+        }
+    }
+    out
 }
 
 impl Truth {
@@ -264,6 +283,20 @@ impl Truth {
     pub fn model_error(&self, x: &[[f32; 4]]) -> f64 {
         let e = super::metrics::relative_rmse(x, &self.image.indirect, &self.mask.mask);
         (e * e - self.noise * self.noise).max(0.0).sqrt()
+    }
+
+    /// The truth of `b` bounces this truth holds, with its noise: itself,
+    /// or for a count under 4 and under its own, the sum of its first
+    /// layers (docs/algorithm.md section 6.6); `None` for more than it has,
+    /// or a count its fourth layer (bounces 4 and on, together) mixes.
+    pub fn of(&self, b: Bounces) -> Option<(Vec<[f32; 4]>, f64)> {
+        if b == self.bounces {
+            return Some((self.image.indirect.clone(), self.noise));
+        }
+        let n = b.last()? as usize;
+        let holds = self.bounces.last().is_none_or(|m| n as u32 <= m);
+        (holds && n < crate::bounces::LAYERS.len() && n <= self.image.bounces.len())
+            .then(|| (first_layers(&self.image, n), self.noises[n - 1]))
     }
 }
 
@@ -297,14 +330,16 @@ impl Halves {
         self.spp += spp;
     }
 
-    /// The relative RMSE noise of the mean of both halves over `mask`:
-    /// each half's per-pixel variance is `s^2 / n`, their difference's
-    /// `2 s^2 / n` and the mean's `s^2 / 2n`, a quarter of the difference's.
-    fn noise(&self, mask: &[bool]) -> f64 {
+    /// The relative RMSE noise of the mean of both halves over `mask`
+    /// (of the sum of their first `layers` layers by bounce): each half's
+    /// per-pixel variance is `s^2 / n`, their difference's `2 s^2 / n` and
+    /// the mean's `s^2 / 2n`, a quarter of the difference's.
+    fn noise(&self, mask: &[bool], layers: usize) -> f64 {
+        let (a, b) = (first_layers(&self.a, layers), first_layers(&self.b, layers));
         let (mut d, mut m) = (0.0f64, 0.0f64);
         for k in (0..mask.len()).filter(|&k| mask[k]) {
             for c in 0..3 {
-                let (x, y) = (self.a.indirect[k][c] as f64, self.b.indirect[k][c] as f64);
+                let (x, y) = (a[k][c] as f64, b[k][c] as f64);
                 d += (x - y) * (x - y);
                 m += 0.25 * (x + y) * (x + y);
             }
@@ -379,7 +414,17 @@ pub fn trace(
         spp: FIRST_SPP,
     };
     let mask = truth_mask(g, &halves.a.direct, shadows);
-    let mut noise = halves.noise(&mask.mask);
+    // The noise of the image of every bounce count it serves (1, 2, 3,
+    // all): the truth of fewer bounces is the sum of its first layers, and
+    // must be under the target too.
+    let noises = |h: &Halves| -> Vec<f64> {
+        (1..=bounces.layers())
+            .map(|n| h.noise(&mask.mask, n))
+            .collect()
+    };
+    let worst = |n: &[f64]| n.iter().copied().fold(0.0, f64::max);
+    let mut each = noises(&halves);
+    let mut noise = worst(&each);
     progress(2 * halves.spp, noise);
     while noise > target && 2 * halves.spp < MAX_SPP {
         // Noise falls as 1/sqrt(spp): aim a little past the target.
@@ -390,7 +435,8 @@ pub fn trace(
             .max(FIRST_SPP);
         let (a, b) = (pass(more, seeds()), pass(more, seeds()));
         halves.add(a, b, more);
-        noise = halves.noise(&mask.mask);
+        each = noises(&halves);
+        noise = worst(&each);
         progress(2 * halves.spp, noise);
     }
     let spp = 2 * halves.spp;
@@ -399,7 +445,8 @@ pub fn trace(
         bounces,
         mask,
         spp,
-        noise,
+        noise: *each.last().unwrap_or(&noise),
+        noises: each,
     }
 }
 

@@ -52,7 +52,8 @@ pub(super) fn model_floor(
 }
 
 /// The path-traced truth of frame `k` of `spec` at the run's noise target
-/// and bounces (`--bounces`), cached in the run's folder
+/// and bounces (`--bounces`; every bounce where the run has the bounces
+/// axis, whose layers hold the truth of one: `Plan::truth_bounces`), cached in the run's folder
 /// (`truth/SCENE/frame-K.exr`, with a note of its bounces, samples and
 /// noise), compared on the pixels of `g` (the reference's G-buffer, whose
 /// RSMs `r` holds) away from edges.
@@ -69,7 +70,7 @@ pub(super) fn frame_truth(
         time: frame_time(spec, k),
         target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
         seed: k as u64 + 1,
-        bounces: plan.bounces(),
+        bounces: plan.truth_bounces(),
     };
     let path = super::files::truth_dir(&plan.out_dir, &spec.name)
         .join(super::bounces::truth_file(k, key.bounces));
@@ -120,6 +121,10 @@ struct CacheNote {
     target: f64,
     spp: u32,
     noise: f64,
+    /// The noise of the sum of its first n layers by bounce (n from 1),
+    /// where noted (`Truth::noises`); else its one `noise`.
+    #[serde(default)]
+    noises: Vec<f64>,
 }
 
 fn one_bounce() -> String {
@@ -158,7 +163,7 @@ fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<V
 /// measured under it; anything else is traced again. The bounces must
 /// match exactly: a truth of other bounces is another image, and its noise
 /// was measured on that image.
-fn cached(path: &Path, g: &Readback, key: &FrameKey) -> Option<(Readback, u32, f64)> {
+fn cached(path: &Path, g: &Readback, key: &FrameKey) -> Option<(Readback, u32, f64, Vec<f64>)> {
     use crate::settings::ParamType as _;
     let note: CacheNote =
         serde_json::from_slice(&std::fs::read(path.with_extension("json")).ok()?).ok()?;
@@ -188,7 +193,11 @@ fn cached(path: &Path, g: &Readback, key: &FrameKey) -> Option<(Readback, u32, f
         None if key.bounces == Bounces::ONE => vec![r.indirect.clone()],
         None => return None,
     };
-    Some((r, note.spp, note.noise))
+    let noises = match note.noises.len() == r.bounces.len() {
+        true => note.noises,
+        false => vec![note.noise; r.bounces.len()],
+    };
+    Some((r, note.spp, note.noise, noises))
 }
 
 /// Which truth of a scene a bench frame needs: its animation time, the
@@ -214,7 +223,7 @@ fn traced_or_cached(
     key: FrameKey,
     progress: impl Fn(u32, f64),
 ) -> anyhow::Result<Truth> {
-    if let Some((image, spp, noise)) = cached(path, g, &key) {
+    if let Some((image, spp, noise, noises)) = cached(path, g, &key) {
         let mask = truth_mask(g, &image.direct, shadows);
         return Ok(Truth {
             image,
@@ -222,6 +231,7 @@ fn traced_or_cached(
             mask,
             spp,
             noise,
+            noises,
         });
     }
     let FrameKey {
@@ -240,6 +250,7 @@ fn traced_or_cached(
         target,
         spp: truth.spp,
         noise: truth.noise,
+        noises: truth.noises.clone(),
     };
     crate::output::write_text(
         &path.with_extension("json"),
@@ -330,7 +341,7 @@ mod tests {
             bounces,
         };
         let g = image(0.0);
-        let (r, spp, _) = cached(&path, &g, &key(Bounces::ONE)).expect("served as one bounce");
+        let (r, spp, _, _) = cached(&path, &g, &key(Bounces::ONE)).expect("served as one bounce");
         assert_eq!(spp, 64);
         assert_eq!(r.bounces, vec![r.indirect.clone()]);
         assert!(cached(&path, &g, &key(Bounces::Count(2))).is_none());
@@ -348,10 +359,11 @@ mod tests {
             target: 0.1,
             spp: 64,
             noise: 0.05,
+            noises: vec![],
         };
         let json = serde_json::to_string(&note).unwrap();
         std::fs::write(path.with_extension("json"), json).unwrap();
-        let (r, _, _) = cached(&path, &g, &key(Bounces::Infinite)).expect("served");
+        let (r, _, _, _) = cached(&path, &g, &key(Bounces::Infinite)).expect("served");
         assert_eq!(r.bounces.len(), 4);
         assert_eq!(r.bounces[3][0][0], 0.125);
         assert!(cached(&path, &g, &key(Bounces::ONE)).is_none());
