@@ -229,3 +229,25 @@ fn the_default_is_the_best_balance_of_the_published_run() {
         );
     }
 }
+
+/// The default bounces are the subject's best balance on the published
+/// run's bounces axis (`bench::bounce_axis::default_bounces`, the same rule
+/// as the other defaults, against the truth of every bounce): `isr render`
+/// with no option renders the bounces docs/results.md names.
+#[test]
+fn the_default_bounces_are_the_best_balance_of_the_published_bounces_axis() {
+    use isr::settings::params::AnyParam as _;
+    let json: serde_json::Value =
+        serde_json::from_str(&read("docs/results/results.json")).expect("results.json");
+    let rows: Vec<isr::bench::rows::Row> = serde_json::from_value(json["bounce_axis"].clone())
+        .expect("the published run's bounces axis (`bounce_axis` in results.json)");
+    let (best, _) = isr::bench::bounce_axis::default_bounces(&rows);
+    let best = best.expect("a best balance of the subject's bounces");
+    let ours = isr::bounces::BOUNCES.text_in(&isr::settings::RenderSettings::default());
+    assert_eq!(
+        ours, best.label,
+        "--bounces: the default is {ours}, the best balance of docs/results.md's bounces axis {} \
+         ({:.2}x the lowest error against the truth of every bounce)",
+        best.label, best.relative_error
+    );
+}
