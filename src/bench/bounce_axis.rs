@@ -5,9 +5,13 @@
 //! subject with 1, 2, 3 and `inf`: the candidates of its default), each
 //! measured against the truth of every bounce, and its extra light (the
 //! light bounces 2..N add, `I_N - I_1`) against what they add in the truth
-//! (`T_N - T_1`). The truth of every bounce is the run's one trace per
-//! frame: its layers by bounce hold the truth of one bounce the other rows
-//! are measured against (`Plan::truth_bounces`), so nothing is traced twice.
+//! (`T_N - T_1`), at the middle animation frame (`Plan::axis_frame`; the
+//! frames before it rendered, for what carries over between frames). The
+//! truth of every bounce is that frame's one trace: its layers by bounce
+//! hold the truth of one bounce the other rows are measured against
+//! (`Plan::truth_bounces`), so nothing is traced twice, and the other
+//! frames' truths stay of one bounce (the truth of every bounce took 3.4x
+//! as long on the box).
 //! Its rows are apart from the others (`Outcome::bounce_rows`, their own
 //! keys): the run's tables and charts stay of one bounce.
 
@@ -58,11 +62,17 @@ pub fn on(quick: bool, truth: bool, bounces: Bounces, list: &[Method]) -> bool {
 }
 
 impl Plan {
-    /// The bounces of the truth this plan traces: every bounce where it
-    /// measures the axis (its first layer is the truth of one), else
-    /// `--bounces`.
-    pub fn truth_bounces(&self) -> Bounces {
-        match self.bounce_axis {
+    /// The frame the axis is measured at: the middle one (as the model's
+    /// floor is), so that only its truth is of every bounce.
+    pub fn axis_frame(&self) -> u32 {
+        self.frames / 2
+    }
+
+    /// The bounces of the truth this plan traces at frame `k`: every
+    /// bounce at the axis's frame where it measures the axis (its first
+    /// layer is the truth of one), else `--bounces`.
+    pub fn truth_bounces(&self, k: u32) -> Bounces {
+        match self.bounce_axis && k == self.axis_frame() {
             true => Bounces::Infinite,
             false => self.bounces(),
         }
@@ -167,8 +177,9 @@ pub fn shares(truths: &[Vec<[f32; 4]>], mask: &[bool]) -> Vec<f64> {
         .collect()
 }
 
-/// Renders the axis's `work` (`pending`) of scene `spec` and journals its
-/// rows. `truths`: each frame's, traced where missing (by the first method).
+/// Renders the axis's `work` (`pending`) of scene `spec` up to its frame
+/// and journals its rows. `truths`: each frame's; the axis frame's is
+/// traced where missing (by the first method).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn run(
     plan: &Plan,
@@ -182,9 +193,9 @@ pub(super) fn run(
 ) -> Result<()> {
     let axis = plan.axis_plan();
     for points in work {
-        // The method's images of one bounce, per frame: what its extra
-        // light is measured from.
-        let mut one: Vec<Vec<[f32; 4]>> = vec![];
+        // The method's image of one bounce at the axis's frame: what its
+        // extra light is measured from.
+        let mut one: Option<Vec<[f32; 4]>> = None;
         for p in points {
             let mut s = p.config.settings(&axis.base);
             BOUNCES.set(&mut s, p.bounces);
@@ -195,18 +206,18 @@ pub(super) fn run(
             let mut stats = FrameStats::default();
             let (mut e_all, mut e_same) = (0.0, 0.0);
             let (mut extra, mut extra_truth) = (0.0, 0.0);
-            let mut share = vec![0.0; SUBJECT_BOUNCES.len()];
-            for k in 0..axis.frames {
-                bar.set_message(format!(
-                    "{}: {name}, frame {}/{}",
-                    spec.name,
-                    k + 1,
-                    axis.frames
-                ));
+            let mut share = vec![];
+            let at = axis.axis_frame();
+            for k in 0..=at {
+                bar.set_message(format!("{}: {name}, frame {}/{}", spec.name, k + 1, at + 1));
                 let state = scene.pose_at(frame_time(spec, k))?;
                 r.update(&state)?;
                 let n = if k == 0 { axis.timing_frames } else { 1 };
-                stats.extend(r.render_frames_counting(n, k + 1 == axis.frames, |_| {})?);
+                stats.extend(r.render_frames_counting(n, k == at, |_| {})?);
+                bar.inc(1);
+                if k < at {
+                    continue;
+                }
                 let out = r.readback()?;
                 let slot = &mut truths[k as usize];
                 if slot.is_none() {
@@ -225,26 +236,23 @@ pub(super) fn run(
                     Bounces::Infinite => every,
                     b => &t.axis[b.layers() - 1],
                 };
-                e_all += super::metrics::relative_rmse(&out.indirect, every, &t.mask);
-                e_same += super::metrics::relative_rmse(&out.indirect, same, &t.mask);
+                e_all = super::metrics::relative_rmse(&out.indirect, every, &t.mask);
+                e_same = super::metrics::relative_rmse(&out.indirect, same, &t.mask);
                 if p.bounces == Bounces::ONE {
-                    one.push(out.indirect.clone());
-                } else if let Some(i1) = one.get(k as usize) {
-                    extra += light(&out.indirect, &t.mask) - light(i1, &t.mask);
-                    extra_truth += light(same, &t.mask) - light(t1, &t.mask);
+                    one = Some(out.indirect.clone());
+                } else if let Some(i1) = &one {
+                    extra = light(&out.indirect, &t.mask) - light(i1, &t.mask);
+                    extra_truth = light(same, &t.mask) - light(t1, &t.mask);
                 }
-                for (a, b) in share.iter_mut().zip(shares(&t.axis, &t.mask)) {
-                    *a += b / axis.frames as f64;
-                }
-                bar.inc(1);
+                share = shares(&t.axis, &t.mask);
             }
-            let f = axis.frames as f64;
             let mut row = timing_row(&axis, spec, &s, &stats);
             row.key = key(plan, &spec.name, p);
             row.label = label;
             row.is_default = true;
-            row.truth.rel_rmse_indirect = Some(e_all / f);
-            row.truth.same_bounces = Some(e_same / f);
+            row.frames = at + 1;
+            row.truth.rel_rmse_indirect = Some(e_all);
+            row.truth.same_bounces = Some(e_same);
             row.truth.extra_light =
                 (p.bounces != Bounces::ONE && extra_truth.abs() > 0.0).then(|| extra / extra_truth);
             row.truth.shares = Some(share);
@@ -253,7 +261,7 @@ pub(super) fn run(
                     "{}: {name}: {:.1} ms indirect, relative RMSE against every bounce {:.4}",
                     spec.name,
                     row.indirect_ms.unwrap_or(f64::NAN),
-                    e_all / f
+                    e_all
                 );
             }
             rows::append(journal, &row)?;
@@ -315,9 +323,10 @@ pub fn report(rows: &[Row]) -> String {
         return String::new();
     }
     let f4 = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.4}"));
-    let mut md = "\n## Bounces\n\nThe truth of every bounce is traced once per frame; its layers by bounce \
-give the truth of 1, 2 and 3 bounces (docs/algorithm.md section 6.6). Each scene's share of the truth's \
-indirect light per bounce (over the compared pixels, mean over the frames):\n\n\
+    let mut md = "\n## Bounces\n\nThe truth of every bounce is traced once, at the axis's frame; its layers by bounce \
+give the truth of 1, 2 and 3 bounces (docs/algorithm.md section 6.6); the axis is measured at the \
+middle animation frame, the frames before it rendered. Each scene's share of the truth's indirect light \
+per bounce (over the compared pixels):\n\n\
 | scene | bounce 1 | bounce 2 | bounce 3 | bounces 4 and on |\n| --- | ---: | ---: | ---: | ---: |\n"
         .to_string();
     let mut scenes: Vec<&str> = vec![];
@@ -343,7 +352,7 @@ indirect light per bounce (over the compared pixels, mean over the frames):\n\n\
     md += "\nEach method that renders bounces, at its default point and visibility, with each bounces \
 setting (section 5.9): relative RMSE of the indirect image against the truth of every bounce and \
 against the truth of its own bounces; the light its bounces 2..N add over what they add in the truth \
-(`(I_N - I_1) / (T_N - T_1)`, summed over the compared pixels and frames; 1: as much); the median \
+(`(I_N - I_1) / (T_N - T_1)`, summed over the compared pixels; 1: as much); the median \
 indirect ms and, in it, the bounce passes' median ms each.\n\n\
 | scene | method | setting | bounces | RMSE every bounce | RMSE own bounces | extra light | indirect ms | bounce passes (ms) |\n\
 | --- | --- | --- | --- | ---: | ---: | ---: | ---: | --- |\n";
@@ -477,5 +486,39 @@ mod tests {
             *bounces_of(crate::methods::SUBJECT).last().unwrap(),
             Bounces::Infinite
         );
+    }
+
+    #[test]
+    fn only_the_axis_frame_traces_every_bounce_and_the_subject_has_four_points() {
+        let args = |quick| crate::bench::BenchArgs {
+            scenes: vec!["cornell".into()],
+            methods: vec!["hisr".into(), "lpv".into()],
+            frames: Some(6),
+            quick,
+            ..Default::default()
+        };
+        let plan = args(false).plan().unwrap();
+        assert!(plan.bounce_axis);
+        assert_eq!(plan.axis_frame(), 3);
+        for k in 0..6 {
+            let b = if k == 3 {
+                Bounces::Infinite
+            } else {
+                Bounces::ONE
+            };
+            assert_eq!(plan.truth_bounces(k), b, "frame {k}");
+        }
+        // lpv renders one bounce: not on the axis.
+        let scene = plan.for_scene(&plan.scenes[0]);
+        let got: Vec<Bounces> = points(&scene).iter().map(|p| p.bounces).collect();
+        assert_eq!(got, SUBJECT_BOUNCES);
+        let k = key(&scene, "cornell", &points(&scene)[3]);
+        assert!(
+            k.ends_with("|bounce axis inf") && k.contains("voxels"),
+            "{k}"
+        );
+        let quick = args(true).plan().unwrap();
+        assert!(!quick.bounce_axis && points(&quick).is_empty());
+        assert_eq!(quick.truth_bounces(quick.axis_frame()), Bounces::ONE);
     }
 }

@@ -136,7 +136,7 @@ pub struct Plan {
     /// plan (`Plan::passes`): its one visibility.
     pub visibilities: Vec<Visibility>,
     /// Whether the run measures the bounces axis (`bounce_axis::on`), and
-    /// so traces the truth of every bounce (`Plan::truth_bounces`).
+    /// so traces the truth of every bounce at its frame (`Plan::truth_bounces`).
     pub bounce_axis: bool,
 }
 
@@ -496,7 +496,8 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
             units += scene_plan.frames as u64;
         }
         units += passes.iter().map(|(p, w)| w.frames(p)).sum::<u64>();
-        units += axis.iter().map(|m| m.len() as u64).sum::<u64>() * scene_plan.frames as u64;
+        let axis_frames = scene_plan.axis_frame() as u64 + 1;
+        units += axis.iter().map(|m| m.len() as u64).sum::<u64>() * axis_frames;
         pending.push((s.clone(), scene_plan, passes, axis));
     }
     let bar = crate::progress::bar(units, "frames");

@@ -93,7 +93,7 @@ pub struct TruthErrors {
     /// `rel_rmse_indirect` is against the truth of every bounce: its error
     /// against the truth of its own bounces; the light its bounces 2..N add
     /// (`I_N - I_1`) over what they add in the truth (`T_N - T_1`), summed
-    /// over the mask and the frames (1: as much; none for one bounce); and
+    /// over the mask (1: as much; none for one bounce); and
     /// the truth's share of the indirect light of bounces 1, 2, 3 and 4 on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub same_bounces: Option<f64>,

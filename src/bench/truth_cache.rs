@@ -52,8 +52,8 @@ pub(super) fn model_floor(
 }
 
 /// The path-traced truth of frame `k` of `spec` at the run's noise target
-/// and bounces (`--bounces`; every bounce where the run has the bounces
-/// axis, whose layers hold the truth of one: `Plan::truth_bounces`), cached in the run's folder
+/// and bounces (`--bounces`; every bounce at the bounces axis's frame,
+/// whose layers hold the truth of one: `Plan::truth_bounces`), cached in the run's folder
 /// (`truth/SCENE/frame-K.exr`, with a note of its bounces, samples and
 /// noise), compared on the pixels of `g` (the reference's G-buffer, whose
 /// RSMs `r` holds) away from edges.
@@ -70,7 +70,7 @@ pub(super) fn frame_truth(
         time: frame_time(spec, k),
         target: plan.truth_noise.unwrap_or(truth::NOISE_TARGET),
         seed: k as u64 + 1,
-        bounces: plan.truth_bounces(),
+        bounces: plan.truth_bounces(k),
     };
     let path = super::files::truth_dir(&plan.out_dir, &spec.name)
         .join(super::bounces::truth_file(k, key.bounces));
