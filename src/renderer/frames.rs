@@ -96,6 +96,7 @@ impl Renderer<'_> {
                 }
                 p.set_label(labels[i].clone());
             }
+            self.shadow.record(&ctx(cmds[c], v), p);
             self.direct.record(&ctx(cmds[c], v), p);
             if method.reads_rsm_tree() {
                 self.rsm_tree.record(&ctx(cmds[c], v), p);
