@@ -60,12 +60,15 @@ pub(super) fn all_views(
                 .then(|| crate::view::fit_directional(l.direction, &boxes, camera, bounds))
                 .flatten();
             let mut views = light_views(i, l, bounds, fit.as_ref(), rsm);
+            // The shadow is fitted within what the RSM covers: a far object
+            // that the RSM's fit leaves out must not stretch it either.
+            let covered = fit.map_or(bounds, |f| f.footprint);
             for v in views
                 .iter_mut()
                 .filter(|v| v.kind == LightKind::Directional)
             {
                 if let Some(s) = sun_shadow {
-                    v.shadow = crate::view::sun_shadow::fit(v, camera, bounds, s);
+                    v.shadow = crate::view::sun_shadow::fit(v, camera, covered, s);
                 }
             }
             views
