@@ -40,7 +40,7 @@ fn rel_rmse(a: &Readback, b: &Readback) -> f64 {
 /// The least over timed frames (the least disturbed on a shared machine) of
 /// the summed GPU time (ms) of the passes whose names start with `prefix`.
 fn pass_ms(stats: &FrameStats, prefix: &str) -> f64 {
-    let mut per_frame: Vec<f64> = stats
+    let per_frame: Vec<f64> = stats
         .timed()
         .map(|f| {
             f.iter()
