@@ -214,7 +214,7 @@ impl<'g> Renderer<'g> {
             Some(surface) => Some(SurfacePass::new(&setup, surface)?),
             None => None,
         };
-        let bounce = make_bounce(&setup, descriptor)?;
+        let bounce = make_bounce(&setup, descriptor, views.len())?;
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
@@ -416,14 +416,14 @@ fn check_run(
     Ok(d)
 }
 
-/// The bounce passes of a run of `d` made from `setup` (`None` where it
-/// renders one bounce).
-fn make_bounce(setup: &Setup, d: &dyn Descriptor) -> Result<Option<BouncePass>> {
+/// The bounce passes of a run of `d` made from `setup`, for frames of
+/// `views` light views (`None` where it renders one bounce).
+fn make_bounce(setup: &Setup, d: &dyn Descriptor, views: usize) -> Result<Option<BouncePass>> {
     match (
         crate::methods::renders_bounces(d, setup.settings),
         setup.grid_surface,
     ) {
-        (true, Some(surface)) => BouncePass::new(setup, surface),
+        (true, Some(surface)) => BouncePass::new(setup, surface, views),
         _ => Ok(None),
     }
 }
