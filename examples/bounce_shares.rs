@@ -61,7 +61,12 @@ fn measure(gpu: &Gpu, name: &str, size: u32, spp: u32) -> Result<Row> {
     r.render_frames(1, |_| {})?;
     let g = r.readback()?;
     let views = r.light_views().to_vec();
-    let shadows = ShadowMaps::new(&views, r.render_origin(), 128, settings.pcf_radius);
+    let shadows = ShadowMaps::new(
+        &views,
+        r.render_origin(),
+        settings.shadow_size(),
+        settings.pcf_radius,
+    );
     drop(r);
     let started = std::time::Instant::now();
     let half = |seed: u64| {

@@ -223,7 +223,7 @@ fn per_receiver(mut s: RenderSettings) -> RenderSettings {
 /// that frame's indirect image.
 fn truth_of(gpu: &Gpu, scene: &Scene, s: &RenderSettings) -> Result<(Truth, Vec<[f32; 4]>)> {
     let f = render(gpu, scene, s)?;
-    let shadows = ShadowMaps::new(&f.light_views, f.origin, s.rsm_resolution, s.pcf_radius);
+    let shadows = ShadowMaps::new(&f.light_views, f.origin, s.shadow_size(), s.pcf_radius);
     let t = trace(
         scene,
         &f.readback,
@@ -239,7 +239,7 @@ fn truth_of(gpu: &Gpu, scene: &Scene, s: &RenderSettings) -> Result<(Truth, Vec<
 fn voxels_row(gpu: &Gpu, name: &str, scene: &Scene, table: &mut Table) -> Result<()> {
     let s = sized("reference", 64);
     let f = render(gpu, scene, &s)?;
-    let shadows = ShadowMaps::new(&f.light_views, f.origin, 64, s.pcf_radius);
+    let shadows = ShadowMaps::new(&f.light_views, f.origin, s.shadow_size(), s.pcf_radius);
     let t = trace(
         scene,
         &f.readback,

@@ -3,27 +3,28 @@
 // Direct light of one light view (docs/algorithm.md sections 2.3 and 2.4):
 //   L_direct = rho/pi * I(w) * max(0, n.l) / r^2 * V   (spot; point, this cube face's points)
 //   L_direct = rho/pi * E * max(0, n.l) * V            (directional)
-// with V from the RSM depth: 3x3 taps of hardware 2x2 PCF. Several views add up
-// (renderer: light_sum.comp).
+// with V from the shadow map (pass `shadow`: depth only, S x S, the light view's
+// shadow frustum u.shadow_view_proj): 3x3 taps of hardware 2x2 PCF. Several
+// views add up (renderer: light_sum.comp).
 #include "frame.glsl"
 #include "light_types.glsl"
 
 layout(set = 1, binding = 0) uniform sampler2D gbuffer_position;
 layout(set = 1, binding = 1) uniform sampler2D gbuffer_normal;
 layout(set = 1, binding = 2) uniform sampler2D gbuffer_albedo;
-layout(set = 1, binding = 3) uniform sampler2DShadow rsm_depth;  // compare: GREATER_OR_EQUAL
+layout(set = 1, binding = 3) uniform sampler2DShadow shadow_depth;  // compare: GREATER_OR_EQUAL
 
 layout(location = 0) out vec4 out_radiance;  // rgb: W/(m^2 sr)
 
-// The receiver's plane in the RSM's normalized device coordinates: NDC
+// The receiver's plane in the shadow map's normalized device coordinates: NDC
 // depth is an affine function of NDC xy over any plane (a projective map
 // keeps planes planar, perspective or orthographic), z = ndc.z + dot(g, d).
 // From two points one texel off p along the plane, projected.
 vec2 receiver_gradient(vec3 p, vec3 n, vec3 ndc, float texel_world) {
     vec3 t1 = normalize(abs(n.x) < 0.9 ? cross(n, vec3(1.0, 0.0, 0.0)) : cross(n, vec3(0.0, 1.0, 0.0)));
     vec3 t2 = cross(n, t1);
-    vec4 c1 = u.light_view_proj * vec4(p + t1 * texel_world, 1.0);
-    vec4 c2 = u.light_view_proj * vec4(p + t2 * texel_world, 1.0);
+    vec4 c1 = u.shadow_view_proj * vec4(p + t1 * texel_world, 1.0);
+    vec4 c2 = u.shadow_view_proj * vec4(p + t2 * texel_world, 1.0);
     vec3 a = c1.xyz / c1.w - ndc;
     vec3 b = c2.xyz / c2.w - ndc;
     float det = a.x * b.y - a.y * b.x;
@@ -33,11 +34,11 @@ vec2 receiver_gradient(vec3 p, vec3 n, vec3 ndc, float texel_world) {
 }
 
 float visibility(vec3 p, vec3 n) {
-    float res = float(run.rsm_resolution);
-    // One RSM texel spans this many metres at the receiver's depth.
+    float res = float(run.shadow_resolution);
+    // One shadow-map texel spans this many metres at the receiver's depth.
     float texel_world = shadow_texel_world(p);
     vec3 q = p + n * (run.shadow_normal_offset * texel_world);
-    vec4 clip = u.light_view_proj * vec4(q, 1.0);
+    vec4 clip = u.shadow_view_proj * vec4(q, 1.0);
     if (clip.w <= 0.0) return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
@@ -59,7 +60,7 @@ float visibility(vec3 p, vec3 n) {
         for (int x = -1; x <= 1; ++x) {
             vec2 d = vec2(x, y) * (radius / res);
             float z = ndc.z + dot(g, 2.0 * d);
-            sum += texture(rsm_depth, vec3(uv + d, shadow_reference(z, slope)));
+            sum += texture(shadow_depth, vec3(uv + d, shadow_reference(z, slope)));
         }
     return sum / 9.0;
 }

@@ -79,18 +79,18 @@ void rsm_texel(vec3 x, vec2 frag, vec3 n, int face, float min_cos, out vec3 inte
     area = lit ? dw * r2 / cos_j : 0.0;
 }
 
-// Shadow lookup for receiver p (docs/algorithm.md section 2): how many metres
-// one RSM texel spans at p, and the reference depth for a receiver at RSM
+// Shadow lookup for receiver p (docs/algorithm.md section 2.2): how many metres
+// one shadow-map texel spans at p, and the reference depth for a receiver at RSM
 // depth z, with `slope` already in NDC depth (direct_light.frag: the
 // receiver plane's gradient times the texels the compare spans). Perspective
 // reversed-Z depth is near/z, so the constant bias is relative
 // (d(near/z)/(near/z) = -dz/z); orthographic depth is linear, so it is an
 // offset of the depth range.
 float shadow_texel_world(vec3 p) {
-    float res = float(run.rsm_resolution);
-    if (light_is_directional()) return 2.0 * u.rsm_half_extent / res;
+    float res = float(run.shadow_resolution);
+    if (light_is_directional()) return 2.0 * u.shadow_half_extent / res;
     float dist = dot(p - u.light_position, u.light_direction);
-    return 2.0 * u.rsm_half_extent * max(dist, 0.0) / res;
+    return 2.0 * u.shadow_half_extent * max(dist, 0.0) / res;
 }
 
 float shadow_reference(float z, float slope) {

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Transforms scene vertices for the RSM (VIEW_FROM_LIGHT = 1) or the G-buffer (0).
+// Transforms scene vertices for the G-buffer (VIEW_FROM_LIGHT = 0), the RSM (1)
+// or the direct light's shadow map (2).
 #include "frame.glsl"
 
 layout(constant_id = 1) const int VIEW_FROM_LIGHT = 0;
@@ -22,5 +23,8 @@ void main() {
     // The inverse transpose (non-uniform scale in glTF nodes), computed on the host.
     out_normal = mat3(t.normal_from_object) * in_normal;
     out_uv = in_uv;
-    gl_Position = (VIEW_FROM_LIGHT != 0 ? u.light_view_proj : u.camera_view_proj) * world;
+    mat4 view_proj = VIEW_FROM_LIGHT == 2   ? u.shadow_view_proj
+                     : VIEW_FROM_LIGHT == 1 ? u.light_view_proj
+                                            : u.camera_view_proj;
+    gl_Position = view_proj * world;
 }

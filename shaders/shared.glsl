@@ -27,7 +27,7 @@ struct FrameUniforms {
     float rsm_depth_range;  // the orthographic RSM's depth range (m, directional)
     int cube_face;          // a point light's cube face (0..5: +x, -x, +y, -y, +z, -z)
     int light_index;        // the light's index in the scene
-    int pad2;
+    float shadow_half_extent; // as rsm_half_extent, of the shadow map (shadow_view_proj)
     int pad3;
     mat4 cube_view_proj[6]; // point lights: world -> clip of each cube face (+x, -x, +y, -y,
                             // +z, -z), for the one layered draw of all six (rsm_cube.vert)
@@ -37,6 +37,9 @@ struct FrameUniforms {
     float pad4;             // origin like every position): fixed for a run, so what
     vec3 scene_max;         // is fitted to them does not change size as objects move
     float pad5;
+    mat4 shadow_view_proj;  // world -> shadow map clip (direct light's shadows, shadow.rs):
+                            // the RSM's frustum for spot and point lights; a directional
+                            // light's fitted to what the camera sees (docs/algorithm.md 2.2)
 };
 
 // light_kind: what this frame set's RSM is rendered from (docs/algorithm.md section 2.4).
@@ -52,10 +55,10 @@ const int LIGHT_DIRECTIONAL = 2;  // orthographic, fitted to the scene's bounds
 // constants, declared in its shader folder.
 struct RunUniforms {
     // Shadows of the direct light.
-    float shadow_normal_offset;   // RSM texels at the receiver (0 by default)
+    float shadow_normal_offset;   // shadow-map texels at the receiver (0 by default)
     float shadow_depth_bias;      // constant, relative to the distance to the light
-    float pcf_radius;             // PCF tap spacing (RSM texels)
-    float shadow_slope_bias;      // RSM texels of the receiver plane's depth gradient
+    float pcf_radius;             // PCF tap spacing (shadow-map texels)
+    float shadow_slope_bias;      // shadow-map texels of the receiver plane's depth gradient
     // Sizes.
     uvec2 output_size;            // width, height (pixels)
     uint rsm_resolution;          // R
@@ -74,7 +77,7 @@ struct RunUniforms {
     // The voxel grid (docs/algorithm.md section 5.6; src/voxel_grid).
     int grid_side;                // N: finest cells per side (a power of 2)
     int grid_levels;              // levels 0..grid_levels-1, side N >> k (at least 4)
-    int pad0;
+    uint shadow_resolution;       // S: the direct light's shadow map (S x S, docs/algorithm.md 2.2)
     int pad1;
     int pad2;
 };

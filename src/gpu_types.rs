@@ -35,7 +35,8 @@ pub struct FrameUniforms {
     pub rsm_depth_range: f32,
     pub cube_face: i32,
     pub light_index: i32,
-    pub pad2: i32,
+    /// As `rsm_half_extent`, of the shadow map (`shadow_view_proj`).
+    pub shadow_half_extent: f32,
     pub pad3: i32,
     /// Point lights: world -> clip of each cube face, for the layered draw.
     pub cube_view_proj: [[[f32; 4]; 4]; 6],
@@ -48,6 +49,8 @@ pub struct FrameUniforms {
     pub pad4: f32,
     pub scene_max: [f32; 3],
     pub pad5: f32,
+    /// World -> shadow map clip (`view::LightView::shadow`).
+    pub shadow_view_proj: [[f32; 4]; 4],
 }
 
 /// `FrameUniforms::light_kind` values, as in `shaders/shared.glsl`.
@@ -86,7 +89,8 @@ pub struct RunUniforms {
     /// (`voxel_grid::write_uniforms`).
     pub grid_side: i32,
     pub grid_levels: i32,
-    pub pad0: i32,
+    /// S: the direct light's shadow map (`RenderSettings::shadow_size`).
+    pub shadow_resolution: u32,
     pub pad1: i32,
     pub pad2: i32,
 }

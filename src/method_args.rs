@@ -57,7 +57,7 @@ fn heading(p: &dyn AnyParam) -> String {
         Some("Regular VPLs")
     } else if has(rsm_tree::PARAMS) {
         Some("RSM quadtree")
-    } else if p.name() == crate::bounces::BOUNCES.name {
+    } else if p.name() == crate::bounces::BOUNCES.name || p.name() == crate::bounce::FEEDBACK.name {
         Some("Bounces")
     } else {
         None

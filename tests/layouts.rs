@@ -95,7 +95,7 @@ fn frame_uniforms_match_shared_glsl() {
         "scene.vert",
         "tonemap.frag",
     ] {
-        check!(shader, FrameUniforms, "FrameUniforms", pad5: 4, [
+        check!(shader, FrameUniforms, "FrameUniforms", shadow_view_proj: 64, [
             camera_view_proj => "camera_view_proj",
             light_view_proj => "light_view_proj",
             camera_position => "camera_position",
@@ -114,7 +114,7 @@ fn frame_uniforms_match_shared_glsl() {
             rsm_depth_range => "rsm_depth_range",
             cube_face => "cube_face",
             light_index => "light_index",
-            pad2 => "pad2",
+            shadow_half_extent => "shadow_half_extent",
             pad3 => "pad3",
             cube_view_proj => "cube_view_proj",
             grid_cube => "grid_cube",
@@ -122,6 +122,7 @@ fn frame_uniforms_match_shared_glsl() {
             pad4 => "pad4",
             scene_max => "scene_max",
             pad5 => "pad5",
+            shadow_view_proj => "shadow_view_proj",
         ]);
     }
 }
@@ -151,7 +152,7 @@ fn run_uniforms_match_shared_glsl() {
             patch_kernel => "patch_kernel",
             grid_side => "grid_side",
             grid_levels => "grid_levels",
-            pad0 => "pad0",
+            shadow_resolution => "shadow_resolution",
             pad1 => "pad1",
             pad2 => "pad2",
         ]);

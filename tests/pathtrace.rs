@@ -51,7 +51,7 @@ fn compare_direct_layers(scene: &Scene) {
     let shadows = ShadowMaps::new(
         &rendered.light_views,
         rendered.origin,
-        1024,
+        settings.shadow_size(),
         settings.pcf_radius,
     );
     let mask = truth_mask(raster, &traced.direct, &shadows);

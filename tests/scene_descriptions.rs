@@ -368,12 +368,21 @@ fn orbit_centres_and_fields_of_view_are_held_to_the_limits() {
         "{e}"
     );
     // Just wider than the narrowest: the built-in box's floor, in the spot's
-    // inner cone, fills the view, lit in every pixel.
+    // inner cone, fills the view, lit in every pixel. The point is lit by
+    // the path tracer's visibility too (the floor at z = 0.8 m once chosen
+    // here lies 1 cm inside the short block's shadow, lit only through a
+    // 32-texel shadow map's blur).
     let fov = isr::scene::MIN_YFOV.to_degrees() * 1.01;
     let mut scene = isr::scene::cornell::cornell_box();
     scene.animation = None;
-    let spec =
-        description::parse_camera(&format!("position=0,1,3.4:target=0,0,0.8:fov={fov}")).unwrap();
+    let target = Vec3::new(-0.3, 0.0, 0.9);
+    assert!(isr::pathtrace::Occluders::new(&scene).visible(
+        target,
+        Vec3::Y,
+        scene.lights[0].position
+    ));
+    let spec = description::parse_camera(&format!("position=0,1,3.4:target=-0.3,0,0.9:fov={fov}"))
+        .unwrap();
     description::apply(&mut scene, &[], Some(&spec)).unwrap();
     let gpu = common::gpu();
     let r = common::render(&gpu, &scene, &common::sized("none", 32, 32, 32), 1).readback;

@@ -7,7 +7,7 @@ use isr::renderer::Renderer;
 use isr::scene::cornell::cornell_box;
 use isr::settings::{Method, RenderSettings};
 
-const PASSES: [&str; 5] = ["rsm", "gbuffer", "direct", "composite", "tonemap"];
+const PASSES: [&str; 6] = ["rsm", "gbuffer", "shadow", "direct", "composite", "tonemap"];
 
 #[test]
 fn every_pass_is_timed_and_the_sum_fits_in_the_frame_wall_time() {
@@ -196,9 +196,9 @@ fn timings_json_from_the_cli_lists_every_pass() {
     let expected: Vec<&str> = PASSES[..2]
         .iter()
         .chain(&indirect[..1])
-        .chain(&PASSES[2..3])
+        .chain(&PASSES[2..4])
         .chain(&indirect[1..])
-        .chain(&PASSES[3..])
+        .chain(&PASSES[4..])
         .copied()
         .collect();
     assert_eq!(names, expected);

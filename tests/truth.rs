@@ -17,7 +17,12 @@ const ONE: Bounces = Bounces::ONE;
 fn model_error(gpu: &isr::vk::Gpu, scene: &Scene, target: f64) -> (f64, u32, f64, f64) {
     let settings = sized("reference", 64, 64, 64);
     let r = render(gpu, scene, &settings, 1);
-    let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
+    let shadows = ShadowMaps::new(
+        &r.light_views,
+        r.origin,
+        settings.shadow_size(),
+        settings.pcf_radius,
+    );
     let t = trace(scene, &r.readback, &shadows, target, 1, ONE, |_, _| {});
     let e = relative_rmse(&r.readback.indirect, &t.image.indirect, &t.mask.mask);
     (e, t.spp, t.noise, t.mask.left_out())
@@ -32,7 +37,12 @@ fn the_truth_measures_its_own_noise() {
     let scene = cornell_at_rest(true);
     let settings = sized("reference", 64, 64, 64);
     let r = render(&gpu, &scene, &settings, 1);
-    let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
+    let shadows = ShadowMaps::new(
+        &r.light_views,
+        r.origin,
+        settings.shadow_size(),
+        settings.pcf_radius,
+    );
     let a = trace(&scene, &r.readback, &shadows, 0.1, 1, ONE, |_, _| {});
     let b = trace(&scene, &r.readback, &shadows, 0.1, 2, ONE, |_, _| {});
     let apart = relative_rmse(&a.image.indirect, &b.image.indirect, &a.mask.mask);

@@ -193,7 +193,12 @@ fn exact_visibility_brings_the_dense_reference_to_the_truth_in_the_box_with_bloc
     let vpls = isr::exact_visibility::texel_vpls(&r.readback.rsm);
     let o = Occluders::new(&scene);
     let exact = gather(&r.readback, &vpls, Some(&o), |_, _| {});
-    let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
+    let shadows = ShadowMaps::new(
+        &r.light_views,
+        r.origin,
+        settings.shadow_size(),
+        settings.pcf_radius,
+    );
     let t = trace(
         &scene,
         &r.readback,

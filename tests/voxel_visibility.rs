@@ -70,7 +70,12 @@ fn voxel_visibility_changes_nothing_in_the_empty_box() {
             errors.push((g, e));
         }
         // Away from the room's edges (the truth's mask, section 6.6).
-        let shadows = ShadowMaps::new(&without.light_views, without.origin, 64, s.pcf_radius);
+        let shadows = ShadowMaps::new(
+            &without.light_views,
+            without.origin,
+            s.shadow_size(),
+            s.pcf_radius,
+        );
         let away =
             isr::bench::truth::truth_mask(&without.readback, &without.readback.direct, &shadows)
                 .mask;
@@ -186,7 +191,12 @@ fn the_grid_converges_to_exact_visibility_and_brings_the_box_nearer_the_truth() 
         );
     }
     assert!(errors[3] < 0.25 * none, "{errors:?} against {none}");
-    let shadows = ShadowMaps::new(&r.light_views, r.origin, 64, settings.pcf_radius);
+    let shadows = ShadowMaps::new(
+        &r.light_views,
+        r.origin,
+        settings.shadow_size(),
+        settings.pcf_radius,
+    );
     let t = trace(
         &scene,
         &r.readback,

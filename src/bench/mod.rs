@@ -19,6 +19,7 @@ pub mod ratios;
 pub mod report;
 pub mod rows;
 pub mod scenes;
+mod shared_passes;
 pub mod sweep;
 pub mod truth;
 mod truth_cache;

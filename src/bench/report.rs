@@ -99,6 +99,7 @@ truth of each frame).{}\n\n",
     md += &super::headline::balance_section(o);
     md += "\n";
     md += &model_errors(plan, o);
+    md += &super::shared_passes::table(plan, &o.rows);
     md += &flicker_table(plan, o);
     md += &super::visibility::report_table(plan, &o.rows);
     md += &super::bounce_axis::report(&o.bounce_rows);

@@ -7,9 +7,10 @@
 //!   coverage differs;
 //! - direct-light shadow edges: percentage-closer filtering blurs a shadow
 //!   over its filter's footprint in the shadow map, the path tracer's
-//!   shadows are exact. The footprint is measured in RSM texels, so the band
-//!   is found in the light's view, not the camera's: at a grazing light one
-//!   texel can span many pixels.
+//!   shadows are exact. The footprint is measured in shadow-map texels
+//!   (`RenderSettings::shadow_size`, in each view's shadow frustum), so the
+//!   band is found in the light's view, not the camera's: at a grazing
+//!   light one texel can span many pixels.
 
 use crate::bounces::Bounces;
 use crate::readback::Readback;
@@ -38,14 +39,16 @@ pub struct ShadowMaps<'a> {
     pub views: &'a [LightView],
     /// The render origin the views' matrices are relative to.
     pub origin: DVec3,
+    /// The shadow map's side S (`RenderSettings::shadow_size`).
     pub resolution: u32,
-    /// Half-width of the band PCF may blur (RSM texels): its taps' spacing
+    /// Half-width of the band PCF may blur (shadow-map texels): its taps' spacing
     /// plus the hardware 2x2 compare's texel, plus half a texel for where
     /// the shadow map rasterised the occluder's edge.
     pub band_texels: f32,
 }
 
 impl<'a> ShadowMaps<'a> {
+    /// `resolution`: the shadow map's side (`RenderSettings::shadow_size`);
     /// `pcf_radius`: the PCF tap spacing in texels (`RenderSettings`).
     pub fn new(views: &'a [LightView], origin: DVec3, resolution: u32, pcf_radius: f32) -> Self {
         ShadowMaps {
@@ -56,10 +59,11 @@ impl<'a> ShadowMaps<'a> {
         }
     }
 
-    /// Texel coordinates of world point `p` in view `v`, if in front of it.
+    /// Texel coordinates of world point `p` in view `v`'s shadow map, if
+    /// in front of it.
     fn texel(&self, v: &LightView, p: Vec3) -> Option<Vec2> {
         let rel = (p.as_dvec3() - self.origin).as_vec3();
-        let clip = v.view_proj * rel.extend(1.0);
+        let clip = v.shadow.view_proj * rel.extend(1.0);
         (clip.w > 0.0).then(|| {
             let ndc = Vec2::new(clip.x, clip.y) / clip.w;
             (ndc + 1.0) * 0.5 * self.resolution as f32
@@ -496,7 +500,7 @@ mod tests {
         }
     }
 
-    /// A sun straight down whose RSM of `r` texels spans the floor's 16 m.
+    /// A sun straight down whose shadow map of `r` texels spans the floor's 16 m.
     fn sun_view() -> LightView {
         // World x, z in [-8, 8] to clip [-1, 1]; depth unused here.
         let view_proj = Mat4::from_cols_array(&[
@@ -527,6 +531,7 @@ mod tests {
             half_extent: 8.0,
             depth_range: 10.0,
             cube: [Mat4::ZERO; 6],
+            shadow: crate::view::ShadowFrustum::of_rsm(view_proj, 8.0),
         }
     }
 
@@ -547,7 +552,7 @@ mod tests {
 
     #[test]
     fn geometric_edges_are_left_out_grown_by_a_pixel_and_shadow_edges_by_pcf_texels() {
-        // RSM 64: a texel is a pixel (0.25 m), the band 2.5 texels; RSM 16:
+        // Shadow map 64: a texel is a pixel (0.25 m), the band 2.5 texels; 16:
         // a texel is 4 pixels, the band 10 pixels.
         for (r, band) in [(64, 2.5f32), (16, 10.0)] {
             let kept = kept_columns(r);
@@ -560,7 +565,7 @@ mod tests {
                 assert_eq!(
                     kept.contains(&x),
                     !near_shadow && !near_step,
-                    "RSM {r}: column {x} (kept: {kept:?})"
+                    "shadow map {r}: column {x} (kept: {kept:?})"
                 );
             }
         }

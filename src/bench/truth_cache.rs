@@ -78,7 +78,7 @@ pub(super) fn frame_truth(
     let shadows = truth::ShadowMaps::new(
         r.light_views(),
         r.render_origin(),
-        plan.base.rsm_resolution,
+        plan.base.shadow_size(),
         plan.base.pcf_radius,
     );
     let message = |spp: u32, noise: f64| {

@@ -22,12 +22,48 @@
 //! A method takes part through `Descriptor::renders_bounces`; with
 //! `--bounces 1` none of these passes is made, so one bounce renders the
 //! same commands as before.
+//!
+//! With `--bounce-feedback on` (an ablation knob, `--bounces inf` only)
+//! step 3 is `bounce-feedback` instead: one propagation from the power each
+//! view's cells re-emitted over every bounce the frame before, kept per
+//! view, so that the series is summed over frames; by default nothing is.
 
 mod passes;
 pub use passes::BouncePass;
 
 use crate::bounces::{Bounces, BOUNCES};
+use crate::settings::params::{DefaultValue, Param, ParamType as _, Range};
 use crate::settings::RenderSettings;
+use anyhow::{bail, Result};
+
+/// `--bounce-feedback`: last frame's bounced light is this frame's source
+/// (docs/algorithm.md section 5.9, "Temporal feedback").
+pub const FEEDBACK: Param<bool> = Param {
+    name: "bounce-feedback",
+    help: "With --bounces inf: one propagation a frame from the cells' bounced power of the \
+           frame before, which sums the series over frames (it lags when the light moves) \
+           instead of up to 62 propagations in each; off: nothing is kept between frames",
+    default: DefaultValue::Fixed(false),
+    range: Range::ANY,
+};
+
+/// Whether `s` carries the cells' bounced power from frame to frame.
+pub fn feedback(s: &RenderSettings) -> bool {
+    FEEDBACK.get(s) && BOUNCES.get(s) == Bounces::Infinite
+}
+
+/// Refuses `--bounce-feedback on` without `--bounces inf`: the feedback
+/// sums the whole series, so a count of bounces has no meaning with it.
+pub fn check(s: &RenderSettings) -> Result<()> {
+    if FEEDBACK.get(s) && BOUNCES.get(s) != Bounces::Infinite {
+        bail!(
+            "--bounce-feedback on with --bounces {}: the feedback sums every bounce over \
+             frames; add --bounces inf, or leave --bounce-feedback off",
+            BOUNCES.get(s).text()
+        );
+    }
+    Ok(())
+}
 
 /// Coarse cells per side of the grid's cube, as `shaders/bounce/bounce.glsl`.
 pub const SIDE: u32 = 8;
@@ -51,6 +87,7 @@ pub fn propagations(s: &RenderSettings) -> Option<u32> {
     match BOUNCES.get(s) {
         Bounces::Count(n) if n <= 1 => None,
         Bounces::Count(n) => Some(n - 2),
+        Bounces::Infinite if feedback(s) => Some(1),
         Bounces::Infinite => Some(INFINITE_CAP - 2),
     }
 }
@@ -62,15 +99,23 @@ pub fn active(s: &RenderSettings) -> bool {
 
 /// Bytes of the buffers of the bounce passes for `s` (0 with one bounce):
 /// the cells, three powers, the transfer between every pair of cells, and
-/// the receivers.
+/// the receivers; with feedback a power per light view, counted for the
+/// most views a frame renders (`MAX_LIGHT_VIEWS`: 512 KiB at most).
 pub fn memory(s: &RenderSettings) -> u64 {
     if !active(s) {
         return 0;
     }
     let cells = CELLS as u64;
     let receivers = (s.width.div_ceil(STEP) as u64) * (s.height.div_ceil(STEP) as u64);
-    cells * CELL_BYTES + 3 * cells * 16 + cells * cells * 4 + receivers * 16 + 16
+    let history = match feedback(s) {
+        true => crate::frame::check::MAX_LIGHT_VIEWS as u64 * HISTORY_BYTES,
+        false => 0,
+    };
+    cells * CELL_BYTES + 3 * cells * 16 + cells * cells * 4 + receivers * 16 + 16 + history
 }
+
+/// Bytes of one light view's kept power with feedback: a vec4 per cell.
+const HISTORY_BYTES: u64 = CELLS as u64 * 16;
 
 #[cfg(test)]
 mod tests {
@@ -88,5 +133,18 @@ mod tests {
         let s = RenderSettings::DEFAULT.with(&BOUNCES, Bounces::Infinite);
         assert_eq!(propagations(&s), Some(INFINITE_CAP - 2));
         assert!(memory(&s) > (CELLS as u64).pow(2) * 4);
+        let fed = s.clone().with(&FEEDBACK, true);
+        assert_eq!(propagations(&fed), Some(1));
+        assert_eq!(memory(&fed) - memory(&s), 64 * HISTORY_BYTES);
+    }
+
+    #[test]
+    fn feedback_needs_every_bounce() {
+        let s = RenderSettings::DEFAULT.with(&FEEDBACK, true);
+        for n in [Bounces::ONE, Bounces::Count(3)] {
+            let e = check(&s.clone().with(&BOUNCES, n)).unwrap_err().to_string();
+            assert!(e.contains("add --bounces inf"), "{e}");
+        }
+        assert!(check(&s.with(&BOUNCES, Bounces::Infinite)).is_ok());
     }
 }

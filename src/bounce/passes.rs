@@ -4,9 +4,11 @@
 //! (`compute_to_compute`); the first waits for the previous frame's last
 //! readers of the buffers it writes and for the RSM quadtree and G-buffer
 //! (finished pass outputs, readable by the convention); `bounce-add` takes
-//! `indirect` from its resting state to storage and back.
+//! `indirect` from its resting state to storage and back. With feedback the
+//! views' kept powers are zeroed once, before the run's first frame reads
+//! them, behind the same barriers.
 
-use super::{propagations, CELLS, CELL_BYTES, STEP, VPLS};
+use super::{feedback, propagations, CELLS, CELL_BYTES, HISTORY_BYTES, STEP, VPLS};
 use crate::bounces::{Bounces, BOUNCES};
 use crate::frame::{FrameContext, Setup};
 use crate::passes::{ComputePass, INDIRECT_COMPUTE};
@@ -33,8 +35,19 @@ pub struct BouncePass {
     extent: (u32, u32),
     /// `done` of `bounce-propagate`, cleared every frame.
     state: Buffer,
+    /// With `--bounce-feedback on`: `bounce-feedback` instead of
+    /// `bounce-propagate`, and each light view's kept power.
+    feedback: Option<Feedback>,
     /// Every buffer the passes write, for the barrier before the first.
     _buffers: Vec<Buffer>,
+}
+
+/// The feedback pass (set `v` binds view `v`'s kept power) and the powers,
+/// zeroed by the first frame recorded (`zeroed`).
+struct Feedback {
+    pass: ComputePass,
+    history: Vec<Buffer>,
+    zeroed: std::cell::Cell<bool>,
 }
 
 fn storage(gpu: &Gpu, name: &str, bytes: u64) -> Result<Buffer> {
@@ -49,9 +62,9 @@ fn storage(gpu: &Gpu, name: &str, bytes: u64) -> Result<Buffer> {
 }
 
 impl BouncePass {
-    /// The passes of `setup`'s run over the grid's surface sums `surface`;
-    /// `None` with one bounce.
-    pub fn new(setup: &Setup, surface: &Buffer) -> Result<Option<Self>> {
+    /// The passes of `setup`'s run over the grid's surface sums `surface`,
+    /// for a frame of `views` light views; `None` with one bounce.
+    pub fn new(setup: &Setup, surface: &Buffer, views: usize) -> Result<Option<Self>> {
         let Some(propagations) = propagations(setup.settings) else {
             return Ok(None);
         };
@@ -132,6 +145,38 @@ impl BouncePass {
                 nearest,
             ));
         };
+        let feedback = match feedback(s) {
+            true => {
+                let history = (0..views)
+                    .map(|_| storage(gpu, "power kept for the next frame", HISTORY_BYTES))
+                    .collect::<Result<Vec<_>>>()?;
+                let sets: Vec<Vec<Binding>> = history
+                    .iter()
+                    .map(|h| {
+                        vec![
+                            Binding::storage("BounceCells", &cells),
+                            Binding::storage("BounceTransfer", &transfer),
+                            Binding::storage("BouncePowerSum", &power_sum),
+                            Binding::storage("BounceHistory", h),
+                        ]
+                    })
+                    .collect();
+                let pass = ComputePass::new(
+                    setup,
+                    "bounce-feedback",
+                    "bounce/feedback.comp",
+                    &sets,
+                    0,
+                    &[step],
+                )?;
+                Some(Feedback {
+                    pass,
+                    history,
+                    zeroed: std::cell::Cell::new(false),
+                })
+            }
+            false => None,
+        };
         let mut gather_bindings = vec![];
         gbuffer(&mut gather_bindings);
         gather_bindings.extend([
@@ -171,17 +216,28 @@ impl BouncePass {
             low,
             extent: (s.width, s.height),
             state,
+            feedback,
             _buffers: vec![cells, power_a, power_b, power_sum, transfer, received],
         }))
     }
 
-    /// Records the passes of one light view, after the method's: they add
-    /// bounces 2..N of this view's light to `indirect`.
-    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+    /// Records the passes of light view `view` (an index of the frame's
+    /// views), after the method's: they add bounces 2..N of this view's
+    /// light to `indirect`.
+    pub fn record(&self, ctx: &FrameContext, profiler: &mut Profiler, view: usize) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
         profiler.pass(gpu, cmd, "bounce-cells", INDIRECT_COMPUTE, || {
+            // The kept powers hold nothing before the run's first frame
+            // (the buffers come uninitialised).
+            if let Some(f) = self.feedback.as_ref().filter(|f| !f.zeroed.get()) {
+                for h in &f.history {
+                    let (after, before) = ((compute, rw), (compute, rw));
+                    barrier::zero_buffer(gpu, cmd, h.buffer, vk::WHOLE_SIZE, after, before);
+                }
+                f.zeroed.set(true);
+            }
             // The previous view's or frame's readers of every buffer before
             // they are written again.
             barrier::memory(gpu, cmd, compute, rw, compute, rw);
@@ -190,7 +246,7 @@ impl BouncePass {
         });
         // Two bounces reach receivers from the cells' first: no transfer.
         if self.propagations > 0 {
-            self.record_propagation(ctx, profiler);
+            self.record_propagation(ctx, profiler, view);
         }
         profiler.pass(gpu, cmd, "bounce-gather", INDIRECT_COMPUTE, || {
             self.gather.dispatch_groups(
@@ -211,8 +267,9 @@ impl BouncePass {
         });
     }
 
-    /// `bounce-transfer`, then bounces 3..N among the cells.
-    fn record_propagation(&self, ctx: &FrameContext, profiler: &mut Profiler) {
+    /// `bounce-transfer`, then bounces 3..N among the cells, or with
+    /// feedback one propagation from `view`'s kept power.
+    fn record_propagation(&self, ctx: &FrameContext, profiler: &mut Profiler, view: usize) {
         let (gpu, cmd) = (ctx.gpu, ctx.cmd);
         let rw = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
@@ -221,6 +278,13 @@ impl BouncePass {
                 .dispatch_groups(ctx, 0, &[], (CELLS / 8, CELLS / 8));
             barrier::compute_to_compute(gpu, cmd);
         });
+        if let Some(f) = &self.feedback {
+            profiler.pass(gpu, cmd, "bounce-feedback", INDIRECT_COMPUTE, || {
+                f.pass.dispatch_groups(ctx, view, &[], (1, 1));
+                barrier::compute_to_compute(gpu, cmd);
+            });
+            return;
+        }
         profiler.pass(gpu, cmd, "bounce-propagate", INDIRECT_COMPUTE, || {
             // `done` starts clear, after the previous view's last reader.
             barrier::zero_buffer(

@@ -91,6 +91,10 @@ pub struct RunArgs {
     /// Reflective shadow map resolution R (R x R, a power of two).
     #[arg(long, default_value_t = D.rsm_resolution, help_heading = "Size")]
     pub rsm: u32,
+    /// Shadow map resolution S of the direct light (S x S, a power of two;
+    /// default: 8 texels per pixel of the longer image side, 1024 to 4096).
+    #[arg(long, value_name = "N", help_heading = "Size", hide_short_help = true)]
+    pub shadow: Option<u32>,
     /// Multiplier on radiance before the PNG's sRGB encoding.
     #[arg(long, default_value_t = D.exposure, help_heading = "Output")]
     pub exposure: f32,
@@ -122,6 +126,7 @@ impl RunArgs {
             width: self.width,
             height: self.height,
             rsm_resolution: self.rsm,
+            shadow_resolution: self.shadow.unwrap_or(0),
             method,
             exposure: self.exposure,
             params: self.params.0.clone(),

@@ -60,6 +60,13 @@ pub fn check_settings(gpu: &Gpu, s: &RenderSettings, method_bytes: u64) -> Resul
             max_w.min(max_h)
         );
     }
+    let shadow = s.shadow_size();
+    if shadow > max_w.min(max_h) {
+        bail!(
+            "--shadow {shadow} exceeds this device's image limit of {}",
+            max_w.min(max_h)
+        );
+    }
     let needed = memory_estimate(s, method_bytes);
     within_memory_share(
         &format!(
@@ -225,9 +232,11 @@ pub fn memory_estimate(s: &RenderSettings, method_bytes: u64) -> u64 {
             texels * texel_bytes(t.format)
         })
         .sum();
+    // The direct light's shadow map (`passes::shadow`): depth only.
+    let shadow = (s.shadow_size() as u64).pow(2) * texel_bytes(super::targets::DEPTH_FORMAT);
     // Readback buffers for the largest layers.
     let readback = pixels * 16 * 2;
-    targets + readback + method_bytes
+    targets + shadow + readback + method_bytes
 }
 
 /// The checks of the settings every run shares that need no device: sizes,
@@ -243,6 +252,10 @@ pub fn check_ranges(s: &RenderSettings) -> Result<()> {
     let r = s.rsm_resolution;
     if !r.is_power_of_two() || r < 16 {
         bail!("--rsm {r}: the RSM resolution must be a power of two of at least 16 (it is the root of a quadtree)");
+    }
+    let shadow = s.shadow_resolution;
+    if shadow != 0 && (!shadow.is_power_of_two() || shadow < 16) {
+        bail!("--shadow {shadow}: the shadow map resolution must be a power of two of at least 16");
     }
     if !(s.exposure.is_finite() && s.exposure >= 0.0) {
         bail!(

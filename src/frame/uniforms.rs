@@ -50,6 +50,8 @@ pub fn frame_uniforms(
         cube_view_proj: v.cube.map(|m| m.to_cols_array_2d()),
         scene_min: bounds.0.to_array(),
         scene_max: bounds.1.to_array(),
+        shadow_view_proj: v.shadow.view_proj.to_cols_array_2d(),
+        shadow_half_extent: v.shadow.half_extent,
         ..Default::default()
     }
 }
@@ -76,6 +78,7 @@ pub fn run_uniforms(s: &RenderSettings) -> RunUniforms {
         output_size: [s.width, s.height],
         rsm_resolution: s.rsm_resolution,
         rsm_top_level: s.rsm_top_level() as i32,
+        shadow_resolution: s.shadow_size(),
         exposure: s.exposure,
         ..Default::default()
     }

@@ -258,7 +258,7 @@ pub fn params_of(d: &dyn Descriptor) -> impl Iterator<Item = &'static dyn AnyPar
         &[]
     };
     let bounces: &[&dyn AnyParam] = if d.renders_bounces() {
-        &[&crate::bounces::BOUNCES]
+        &[&crate::bounces::BOUNCES, &crate::bounce::FEEDBACK]
     } else {
         &[]
     };
@@ -356,6 +356,9 @@ pub fn check(s: &RenderSettings) -> Result<&'static dyn Descriptor> {
     }
     if d.reads_visibility() {
         visibility::check(s, d.key().name(), d.takes_exact_visibility())?;
+    }
+    if d.renders_bounces() {
+        crate::bounce::check(s)?;
     }
     d.check(s)?;
     Ok(d)

@@ -4,11 +4,12 @@
 //!
 //! 1. [`rsm`]: reflective shadow map from the spot light ([`ScenePass`]).
 //! 2. [`gbuffer`]: depth, position, normal, albedo from the camera ([`ScenePass`]).
-//! 3. [`direct_light`]: direct radiance, RSM depth as the shadow map ([`FullscreenPass`]).
-//! 4. [`rsm_tree`]: the RSM quadtree, for the methods that read it.
-//! 5. the method (`methods`): writes `Targets::indirect`.
-//! 6. [`composite`]: direct + albedo/pi * indirect irradiance ([`FullscreenPass`]).
-//! 7. [`tonemap`]: sRGB display image for the PNG ([`FullscreenPass`]).
+//! 3. [`shadow`]: the direct light's shadow map, depth only, per light view.
+//! 4. [`direct_light`]: direct radiance, PCF on the shadow map ([`FullscreenPass`]).
+//! 5. [`rsm_tree`]: the RSM quadtree, for the methods that read it.
+//! 6. the method (`methods`): writes `Targets::indirect`.
+//! 7. [`composite`]: direct + albedo/pi * indirect irradiance ([`FullscreenPass`]).
+//! 8. [`tonemap`]: sRGB display image for the PNG ([`FullscreenPass`]).
 //!
 //! Barrier convention (see `vk::barrier`): a pass transitions its outputs from
 //! "discard, after earlier readers" to attachment use, and at its end leaves
@@ -24,6 +25,7 @@ pub mod light_sum;
 pub mod rsm;
 pub mod rsm_cube;
 pub mod rsm_tree;
+pub mod shadow;
 pub mod tonemap;
 
 use crate::frame::{FrameContext, SceneGpu, Setup, Targets};
@@ -277,12 +279,25 @@ pub fn draw_scene_with(
     own: &[vk::DescriptorSet],
     cull: bool,
 ) {
-    let (gpu, cmd) = (ctx.gpu, ctx.cmd);
-    let d = &gpu.device;
     let mut sets = vec![ctx.frame_set, scene.set.set];
     sets.extend_from_slice(own);
+    draw_scene_sets(ctx, pipeline, scene, instances, &sets, cull);
+}
+
+/// [`draw_scene_with`] binding `sets` only (a depth-only pass reads no
+/// materials: set 0 alone).
+pub fn draw_scene_sets(
+    ctx: &FrameContext,
+    pipeline: &Pipeline,
+    scene: &SceneGpu,
+    instances: u32,
+    sets: &[vk::DescriptorSet],
+    cull: bool,
+) {
+    let (gpu, cmd) = (ctx.gpu, ctx.cmd);
+    let d = &gpu.device;
     unsafe {
-        pipeline.bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, &sets);
+        pipeline.bind(gpu, cmd, vk::PipelineBindPoint::GRAPHICS, sets);
         d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
         d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
         for draw in &scene.draws {

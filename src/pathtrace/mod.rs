@@ -17,6 +17,7 @@
 //! the rasterizer's mean (section 2): `indirect` is E, all bounces together.
 
 pub mod bvh;
+pub mod light_seen;
 
 use crate::bounces::Bounces;
 use crate::readback::{Readback, RsmReadback};
@@ -316,8 +317,25 @@ impl Shading<'_> {
         bounces: Bounces,
         rng: &mut Pcg,
     ) -> [Vec3; LAYERS] {
-        let last = bounces.last();
         let mut sums = [Vec3::ZERO; LAYERS];
+        self.paths(s, spp, bounces, rng, |k, _, light| {
+            sums[(k as usize).min(LAYERS) - 1] += light;
+        });
+        sums.map(|sum| sum * (PI / spp as f32))
+    }
+
+    /// The paths of `indirect`: `visit(k, y_k, light)` for every vertex
+    /// `y_k` a path reaches, in order, `light` its bounce-k term before the
+    /// `pi / spp` (`light_seen` classifies the paths by their vertices).
+    fn paths(
+        &self,
+        s: &SurfacePoint,
+        spp: u32,
+        bounces: Bounces,
+        rng: &mut Pcg,
+        mut visit: impl FnMut(u32, &SurfacePoint, Vec3),
+    ) {
+        let last = bounces.last();
         for _ in 0..spp {
             // With one bounce this draws and adds exactly as the one-bounce
             // estimator before it, so a one-bounce image (and every truth
@@ -328,7 +346,7 @@ impl Shading<'_> {
             let mut weight = Vec3::ONE;
             let mut k = 1;
             loop {
-                sums[(k as usize).min(LAYERS) - 1] += weight * self.direct(&y);
+                visit(k, &y, weight * self.direct(&y));
                 if last == Some(k) {
                     break;
                 }
@@ -359,7 +377,6 @@ impl Shading<'_> {
                 k += 1;
             }
         }
-        sums.map(|sum| sum * (PI / spp as f32))
     }
 }
 

@@ -96,6 +96,7 @@ impl Renderer<'_> {
                 }
                 p.set_label(labels[i].clone());
             }
+            self.shadow.record(&ctx(cmds[c], v), p);
             self.direct.record(&ctx(cmds[c], v), p);
             if method.reads_rsm_tree() {
                 self.rsm_tree.record(&ctx(cmds[c], v), p);
@@ -116,7 +117,7 @@ impl Renderer<'_> {
             }
             // Bounces 2..N of this view's light, added to the method's.
             if let Some(bounce) = &self.bounce {
-                bounce.record(&ctx(cmds[c], v), p);
+                bounce.record(&ctx(cmds[c], v), p, v);
             }
             if let Some(sum) = &self.light_sum {
                 if active.len() > 1 {

@@ -129,7 +129,7 @@ impl<'g> Renderer<'g> {
             grid_surface: self.voxel_grid.surface.as_ref(),
         };
         let method = crate::methods::create(&setup)?;
-        let bounce = super::make_bounce(&setup, descriptor)?;
+        let bounce = super::make_bounce(&setup, descriptor, self.views.len())?;
         let passes = (MAX_PASSES + method.submissions() as u32) * self.views.len() as u32;
         for slot in &mut self.slots {
             slot.profiler = Profiler::new(gpu, passes)?;

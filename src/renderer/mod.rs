@@ -22,6 +22,7 @@ use crate::methods::{Descriptor, IndirectMethod};
 use crate::passes::light_sum::LightSumPass;
 use crate::passes::rsm_cube::CubeRsmPass;
 use crate::passes::rsm_tree::{self, RsmTreePass};
+use crate::passes::shadow::ShadowPass;
 use crate::passes::{composite, direct_light, gbuffer, rsm, tonemap, FullscreenPass, ScenePass};
 use crate::scene::{FrameState, LightKind, Scene};
 use crate::settings::RenderSettings;
@@ -99,6 +100,7 @@ pub struct Renderer<'g> {
     method: Box<dyn IndirectMethod>,
     rsm: ScenePass,
     gbuffer: ScenePass,
+    shadow: ShadowPass,
     direct: FullscreenPass,
     rsm_tree: RsmTreePass,
     composite: FullscreenPass,
@@ -135,7 +137,12 @@ impl<'g> Renderer<'g> {
             objects: &object_bounds,
             size: (settings.width, settings.height),
         };
-        let views = all_views(&state, &fitting, settings.rsm_resolution);
+        let views = all_views(
+            &state,
+            &fitting,
+            settings.rsm_resolution,
+            settings.sun_shadow_fit(),
+        );
         // The texture arrays' memory is checked with the rest before anything
         // is allocated; `SceneGpu::new` makes the same plan again (it is
         // cheap: sizes only).
@@ -181,7 +188,8 @@ impl<'g> Renderer<'g> {
         let method = crate::methods::create(&setup)?;
         let rsm = rsm::new(&setup)?;
         let gbuffer = gbuffer::new(&setup)?;
-        let direct = direct_light::new(&setup)?;
+        let shadow = ShadowPass::new(&setup)?;
+        let direct = direct_light::new(&setup, &shadow.depth)?;
         let rsm_tree = RsmTreePass::new(&setup)?;
         let composite = composite::new(&setup)?;
         let tonemap = tonemap::new(&setup)?;
@@ -206,7 +214,7 @@ impl<'g> Renderer<'g> {
             Some(surface) => Some(SurfacePass::new(&setup, surface)?),
             None => None,
         };
-        let bounce = make_bounce(&setup, descriptor)?;
+        let bounce = make_bounce(&setup, descriptor, views.len())?;
         drop(first);
         let passes = (MAX_PASSES + method.submissions() as u32) * views.len() as u32;
         let slots = (0..FRAMES_IN_FLIGHT)
@@ -238,6 +246,7 @@ impl<'g> Renderer<'g> {
             method,
             rsm,
             gbuffer,
+            shadow,
             direct,
             rsm_tree,
             composite,
@@ -279,7 +288,12 @@ impl<'g> Renderer<'g> {
             objects: &self.object_bounds,
             size: (self.settings.width, self.settings.height),
         };
-        self.views = all_views(&self.state, &fitting, self.settings.rsm_resolution);
+        self.views = all_views(
+            &self.state,
+            &fitting,
+            self.settings.rsm_resolution,
+            self.settings.sun_shadow_fit(),
+        );
         Ok(())
     }
 
@@ -402,14 +416,14 @@ fn check_run(
     Ok(d)
 }
 
-/// The bounce passes of a run of `d` made from `setup` (`None` where it
-/// renders one bounce).
-fn make_bounce(setup: &Setup, d: &dyn Descriptor) -> Result<Option<BouncePass>> {
+/// The bounce passes of a run of `d` made from `setup`, for frames of
+/// `views` light views (`None` where it renders one bounce).
+fn make_bounce(setup: &Setup, d: &dyn Descriptor, views: usize) -> Result<Option<BouncePass>> {
     match (
         crate::methods::renders_bounces(d, setup.settings),
         setup.grid_surface,
     ) {
-        (true, Some(surface)) => BouncePass::new(setup, surface),
+        (true, Some(surface)) => BouncePass::new(setup, surface, views),
         _ => Ok(None),
     }
 }

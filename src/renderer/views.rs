@@ -27,8 +27,15 @@ pub(super) struct ViewFitting<'a> {
 /// Every light view of `state`'s lights (`state` relative to the render
 /// origin), in light order, relative to the origin; directional lights'
 /// RSMs fitted to the view where the scene holds much more
-/// (`view::fit_directional`).
-pub(super) fn all_views(state: &FrameState, f: &ViewFitting, rsm: u32) -> Vec<LightView> {
+/// (`view::fit_directional`), and their shadow maps fitted to the camera's
+/// view at `sun_shadow`'s size (`view::sun_shadow::fit`; `None`: the RSM's
+/// square, fixed while the camera moves).
+pub(super) fn all_views(
+    state: &FrameState,
+    f: &ViewFitting,
+    rsm: u32,
+    sun_shadow: Option<u32>,
+) -> Vec<LightView> {
     let bounds = relative(f.bounds, f.origin);
     let directional = state
         .lights
@@ -52,7 +59,19 @@ pub(super) fn all_views(state: &FrameState, f: &ViewFitting, rsm: u32) -> Vec<Li
             let fit = (l.kind == LightKind::Directional)
                 .then(|| crate::view::fit_directional(l.direction, &boxes, camera, bounds))
                 .flatten();
-            light_views(i, l, bounds, fit.as_ref(), rsm)
+            let mut views = light_views(i, l, bounds, fit.as_ref(), rsm);
+            // The shadow is fitted within what the RSM covers: a far object
+            // that the RSM's fit leaves out must not stretch it either.
+            let covered = fit.map_or(bounds, |f| f.footprint);
+            for v in views
+                .iter_mut()
+                .filter(|v| v.kind == LightKind::Directional)
+            {
+                if let Some(s) = sun_shadow {
+                    v.shadow = crate::view::sun_shadow::fit(v, camera, covered, s);
+                }
+            }
+            views
         })
         .collect()
 }

@@ -3,7 +3,9 @@
 //! lights the tests build, the expected direct light written out from
 //! KHR_lights_punctual (not the library's own `Light` methods), CPU sums,
 //! and the bench's error measures (`isr::bench::metrics`). Submodules:
-//! `cli`, the one runner of the `isr` binary; `gltf`, the one builder of
+//! `cli`, the one runner of the `isr` binary; `court`, the sun-lit court of
+//! the shadow tests; `sibenik`, the Sibenik nave of the shadow tests;
+//! `gltf`, the one builder of
 //! glTF and GLB files; `grid`, the voxel visibility settings and the grid
 //! read back; `measure`, work counted on this thread (allocations,
 //! bytes read).
@@ -13,10 +15,12 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod court;
 pub mod framing;
 pub mod gltf;
 pub mod grid;
 pub mod measure;
+pub mod sibenik;
 pub mod sphere;
 
 // Every test binary compiles this kit; most use no grid helper.

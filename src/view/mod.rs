@@ -1,6 +1,8 @@
 //! Camera and light projections, shared by the GPU frame (`frame::uniforms`)
 //! and the CPU path tracer, so both see the scene from the same places.
 
+pub mod sun_shadow;
+
 use crate::scene::{Camera, Light, LightKind, SpotLight};
 use glam::{Mat4, Vec3};
 
@@ -95,6 +97,30 @@ pub struct LightView {
     /// A point light's six faces' `view_proj` (every face view holds all
     /// six: the cube is rendered in one layered draw); zero otherwise.
     pub cube: [Mat4; 6],
+    /// The direct light's shadow map (docs/algorithm.md section 2.2): the
+    /// RSM's frustum for spot and point lights; a directional light's is
+    /// fitted to the camera's view (`sun_shadow::fit`).
+    pub shadow: ShadowFrustum,
+}
+
+/// Where a light view's shadow map looks: world -> shadow clip and, as
+/// `LightView::half_extent`, tan of its half field of view (perspective)
+/// or half its side (m, orthographic). An orthographic shadow map has the
+/// RSM's depth range, so depth biases mean the same in both.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowFrustum {
+    pub view_proj: Mat4,
+    pub half_extent: f32,
+}
+
+impl ShadowFrustum {
+    /// The RSM's own frustum.
+    pub fn of_rsm(view_proj: Mat4, half_extent: f32) -> Self {
+        Self {
+            view_proj,
+            half_extent,
+        }
+    }
 }
 
 impl LightView {
@@ -139,6 +165,7 @@ pub fn light_views(
             half_extent: rsm_half_fov(light).tan(),
             depth_range: 0.0,
             cube: [Mat4::ZERO; 6],
+            shadow: ShadowFrustum::of_rsm(light_view_proj(light, near), rsm_half_fov(light).tan()),
         }],
         LightKind::Point => {
             let cube: [Mat4; 6] = std::array::from_fn(|f| {
@@ -157,6 +184,7 @@ pub fn light_views(
                     half_extent: 1.0,
                     depth_range: 0.0,
                     cube,
+                    shadow: ShadowFrustum::of_rsm(cube[f], 1.0),
                 })
                 .collect()
         }
@@ -320,15 +348,17 @@ fn directional_view(
     let view = Mat4::look_to_rh(eye, d, up);
     // Reversed-Z: depth 1 at the near plane, 0 at the far one; y flipped.
     let ortho = Mat4::orthographic_rh(-half, half, -half, half, range, 0.0);
+    let view_proj = Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0)) * ortho * view;
     LightView {
         light: index,
         kind: LightKind::Directional,
         face: None,
-        view_proj: Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0)) * ortho * view,
+        view_proj,
         position: eye,
         direction: d,
         half_extent: half,
         depth_range: range,
         cube: [Mat4::ZERO; 6],
+        shadow: ShadowFrustum::of_rsm(view_proj, half),
     }
 }
