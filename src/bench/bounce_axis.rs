@@ -402,6 +402,57 @@ lowest. Every setting, cheapest first:\n\n| bounces | error (x the lowest) | ind
     md
 }
 
+/// The headline's table of the axis (empty without its rows): per method
+/// and scene, the error against the truth of every bounce with one bounce
+/// and with every bounce, and the indirect ms with every bounce.
+pub fn headline(rows: &[Row]) -> String {
+    let (one, every) = (Bounces::ONE.text(), Bounces::Infinite.text());
+    let (mut methods, mut scenes): (Vec<&str>, Vec<&str>) = (vec![], vec![]);
+    for r in rows {
+        if !methods.contains(&r.method.as_str()) {
+            methods.push(&r.method);
+        }
+        if !scenes.contains(&r.scene.as_str()) {
+            scenes.push(&r.scene);
+        }
+    }
+    if methods.is_empty() {
+        return String::new();
+    }
+    let default = BOUNCES.get(&crate::settings::RenderSettings::DEFAULT).text();
+    let mut md = format!(
+        "\nEvery bounce (the bounces axis, at the middle animation frame, each method at its default with \
+the grid): the relative RMSE of the indirect image against the path-traced truth of every bounce with one \
+bounce, then with every bounce (`--bounces inf`); and the indirect time with every bounce. The default, \
+`--bounces {default}`, is the best balance of `hisr`'s settings (docs/results.md, \"Bounces\").\n\n| method |"
+    );
+    for s in &scenes {
+        md += &format!(" `{s}` |");
+    }
+    md += "\n| --- |";
+    md += &" ---: |".repeat(scenes.len());
+    md += "\n";
+    let err = |r: Option<&Row>| {
+        r.and_then(|r| r.truth.rel_rmse_indirect)
+            .map_or("-".into(), |e| format!("{e:.3}"))
+    };
+    for m in &methods {
+        md += &format!("| `{m}` |");
+        for s in &scenes {
+            let of = |b: &str| {
+                rows.iter()
+                    .find(|r| r.method == *m && r.scene == *s && r.bounces == b)
+            };
+            let ms = of(&every)
+                .and_then(|r| r.indirect_ms)
+                .map_or("-".into(), super::headline::ms);
+            md += &format!(" {} -> {}, {ms} |", err(of(&one)), err(of(&every)));
+        }
+        md += "\n";
+    }
+    md
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -98,7 +98,7 @@ fn scenes(rows: &[Row]) -> Vec<&str> {
 }
 
 /// "1,234 ms" above 1000, "12 ms" above 10, "9.2 ms" below.
-fn ms(v: f64) -> String {
+pub(super) fn ms(v: f64) -> String {
     match v {
         v if v >= 1000.0 => {
             let n = v.round() as u64;
@@ -187,6 +187,7 @@ own noise included). Full tables, charts and each method's best balance: \
             md += "\n";
         }
     }
+    md += &super::bounce_axis::headline(&o.bounce_rows);
     md += END;
     md += "\n";
     md

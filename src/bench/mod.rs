@@ -287,6 +287,13 @@ impl BenchArgs {
         if visibilities.contains(&Visibility::Voxels) {
             crate::voxel_grid::GRID.check(&base)?;
         }
+        // The sweep's bounces: `--bounces` where given, else one, whatever
+        // the renderer's default (the bounces axis measures the others
+        // against the truth of every bounce, `bounce_axis`).
+        let base = match BOUNCES.is_set_in(&base) {
+            true => base,
+            false => base.with(&BOUNCES, crate::bounces::Bounces::ONE),
+        };
         // The truth's bounces, refused out of range before any work.
         crate::bounces::BOUNCES.check(&base)?;
         if let Some(w) = bounces::warning(&base, &methods).filter(|_| truth_noise > 0.0) {
@@ -357,15 +364,16 @@ impl Plan {
 
     /// Every key this run produces with its rows' visibility, in report
     /// order: per scene, each pass's reference and points.
-    pub fn keys(&self) -> Vec<(String, String)> {
+    pub fn keys(&self) -> Vec<(String, String, bool)> {
         let mut keys = vec![];
         for s in &self.scenes {
             for p in self.for_scene(s).passes() {
                 let v = p.visibility_label();
-                keys.push((p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL), v.clone()));
+                let reference = p.key(&s.name, REFERENCE.name(), REFERENCE_LABEL);
+                keys.push((reference, v.clone(), true));
                 for c in p.configs() {
                     let k = p.key(&s.name, c.method.name(), &c.label(&p.base));
-                    keys.push((k, v.clone()));
+                    keys.push((k, v.clone(), c.is_default(&p.base)));
                 }
             }
         }
@@ -508,13 +516,19 @@ pub fn run(plan: &Plan) -> Result<Outcome> {
     }
     bar.finish_and_clear();
     let all = rows::read_journal(&journal)?.rows;
-    // Rows journalled before the axis have no visibility: their key's.
+    // Rows journalled before the axis have no visibility: their key's. A
+    // row is its method's default by today's defaults, not by those of the
+    // run that journalled it (a resumed run after a default moved).
     let rows: Vec<Row> = plan
         .keys()
         .into_iter()
-        .filter_map(|(k, visibility)| {
+        .filter_map(|(k, visibility, is_default)| {
             let r = all.iter().rev().find(|r| r.key == k).cloned()?;
-            Some(Row { visibility, ..r })
+            Some(Row {
+                visibility,
+                is_default,
+                ..r
+            })
         })
         .collect();
     let bounce_rows: Vec<Row> = bounce_axis::keys(plan)
