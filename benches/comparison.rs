@@ -2,8 +2,8 @@
 //! composite (the built-in Cornell box, 256x256, RSM 256, 256 VPLs where a
 //! method takes N), against the converged `reference` (all 65,536 RSM texels
 //! at full resolution), plus the path tracer (256 spp) to show what ignoring
-//! indirect visibility costs (every method without `--visibility`, as the
-//! paper's). Prints indirect GPU time and the relative RMSE of the indirect
+//! indirect visibility costs (every method without `--visibility` and with
+//! one bounce, as the paper's). Prints indirect GPU time and the relative RMSE of the indirect
 //! and final images; writes `target/bench/comparison.json`, one PNG per
 //! method to `target/bench/comparison/`, and the README's picture of the box
 //! by nine methods, `assets/comparison.png` ([`MONTAGE`], in reading order).
@@ -65,7 +65,10 @@ fn main() -> anyhow::Result<()> {
     .with(
         &isr::visibility::VISIBILITY,
         isr::visibility::Visibility::None,
-    );
+    )
+    // One bounce, the paper's model, which every method here renders
+    // (`lpv` and `vct` have no further bounces).
+    .with(&isr::bounces::BOUNCES, isr::bounces::Bounces::ONE);
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench/comparison");
     std::fs::create_dir_all(&dir)?;
     let run = |method: Method, frames: u32| -> anyhow::Result<(Readback, f64)> {

@@ -179,11 +179,13 @@ fn timings_json_from_the_cli_lists_every_pass() {
     assert_eq!(v["frames"], 3);
     let passes = v["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    // The default method, HISR with the voxel grid, adds its indirect
-    // passes: the grid after the G-buffer (it needs only the posed scene),
-    // the rest between direct light and the composite.
+    // The default method, HISR with the voxel grid and every bounce, adds
+    // its indirect passes: the grid and the surface in its cells after the
+    // G-buffer (they need only the posed scene), the rest between direct
+    // light and the composite, the bounces last.
     let indirect = [
         "voxel-grid",
+        "voxel-surface",
         "rsm-tree",
         "geometry-mips",
         "stencil-refine",
@@ -192,12 +194,17 @@ fn timings_json_from_the_cli_lists_every_pass() {
         "hisr-visibility",
         "gather",
         "upsample",
+        "bounce-cells",
+        "bounce-transfer",
+        "bounce-propagate",
+        "bounce-gather",
+        "bounce-add",
     ];
     let expected: Vec<&str> = PASSES[..2]
         .iter()
-        .chain(&indirect[..1])
+        .chain(&indirect[..2])
         .chain(&PASSES[2..4])
-        .chain(&indirect[1..])
+        .chain(&indirect[2..])
         .chain(&PASSES[4..])
         .copied()
         .collect();

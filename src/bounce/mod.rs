@@ -123,7 +123,7 @@ mod tests {
 
     #[test]
     fn propagations_per_bounce_count() {
-        let s = RenderSettings::DEFAULT;
+        let s = RenderSettings::DEFAULT.with(&BOUNCES, Bounces::ONE);
         assert_eq!(propagations(&s), None);
         assert_eq!(memory(&s), 0);
         for (n, p) in [(2, 0), (3, 1), (8, 6)] {

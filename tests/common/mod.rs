@@ -125,7 +125,8 @@ pub fn assert_validation_clean(gpu: &Gpu) {
 
 /// `method` at `width` x `height` with an RSM of `rsm` in the paper's model
 /// (`--visibility none`: the CPU sums the tests hold the GPU to have no
-/// occlusion; a test of the grid sets it), every other setting the default.
+/// occlusion; a test of the grid sets it; one bounce, as the paper's and
+/// the sums': a test of bounces sets them), every other setting the default.
 pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderSettings {
     RenderSettings {
         width,
@@ -138,6 +139,7 @@ pub fn sized(method: &'static str, width: u32, height: u32, rsm: u32) -> RenderS
         &isr::visibility::VISIBILITY,
         isr::visibility::Visibility::None,
     )
+    .with(&isr::bounces::BOUNCES, isr::bounces::Bounces::ONE)
 }
 
 /// `s` with the parameters that set the cost of its method made small, only
