@@ -205,25 +205,7 @@ fn the_sum_over_n_bounces_grows_with_n_and_converges() {
 /// and later add exactly nothing: a black surface ends every path.
 #[test]
 fn black_walls_add_nothing_beyond_the_first_bounce() {
-    let light = spot(Vec3::new(0.0, 1.5, 0.0), Vec3::ZERO, 4.0, 30.0, 40.0);
-    let camera = Camera::look_at(
-        Vec3::new(0.0, 1.8, 1.2),
-        Vec3::new(0.0, 0.2, -0.3),
-        Vec3::Y,
-        70f32.to_radians(),
-        0.01,
-    );
-    let mut s = floor_scene(light, camera, 1.0, 0.5);
-    let black = s.add_material("black", Vec3::ZERO);
-    for inward in [Vec3::X, -Vec3::X, Vec3::Z, -Vec3::Z] {
-        // Counter-clockwise seen from inside: along Y x inward, then up.
-        let (c, d) = (-inward, Vec3::Y.cross(inward));
-        s.add_quad(
-            "wall",
-            [c - d, c + d, c + d + Vec3::Y, c - d + Vec3::Y],
-            black,
-        );
-    }
+    let s = floor_in_black_walls();
     let traced = pt(&s, 32, 32, 1, Bounces::Infinite);
     let mut lit_walls = 0;
     for i in 0..traced.indirect.len() {

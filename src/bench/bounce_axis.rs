@@ -419,7 +419,9 @@ pub fn headline(rows: &[Row]) -> String {
     if methods.is_empty() {
         return String::new();
     }
-    let default = BOUNCES.get(&crate::settings::RenderSettings::DEFAULT).text();
+    let default = BOUNCES
+        .get(&crate::settings::RenderSettings::DEFAULT)
+        .text();
     let mut md = format!(
         "\nEvery bounce (the bounces axis, at the middle animation frame, each method at its default with \
 the grid): the relative RMSE of the indirect image against the path-traced truth of every bounce with one \
