@@ -6,11 +6,11 @@ mod common;
 
 use common::sphere::{series, sphere, spot_power};
 use common::*;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use isr::bounces::{Bounces, LAYERS};
 use isr::pathtrace::{render as trace, PathTraceSettings};
 use isr::readback::Readback;
-use isr::scene::{Camera, Scene};
+use isr::scene::Scene;
 
 fn pt(scene: &Scene, size: u32, spp: u32, seed: u64, bounces: Bounces) -> Readback {
     trace(
