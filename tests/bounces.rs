@@ -4,6 +4,7 @@
 //! against each other; and a black surface that ends every path.
 mod common;
 
+use common::black_walls::floor_in_black_walls;
 use common::sphere::{series, sphere, spot_power};
 use common::*;
 use glam::DVec3;

@@ -14,6 +14,7 @@
 //! they never skip, so a missing install step shows up in CI.
 #![allow(dead_code)]
 
+pub mod black_walls;
 pub mod cli;
 pub mod court;
 pub mod framing;
@@ -409,32 +410,6 @@ pub fn add_square(s: &mut Scene, name: &str, c: Vec3, half: f32, albedo: f32) {
 pub fn floor_scene(light: Light, camera: Camera, half: f32, albedo: f32) -> Scene {
     let mut s = Scene::empty("floor", light, camera);
     add_square(&mut s, "floor", Vec3::ZERO, half, albedo);
-    s
-}
-
-/// A grey floor in a box of black walls (albedo 0, open above), a spot on
-/// the floor: the floor's light reaches the walls (the first bounce), and
-/// nothing reflects it on, since the floor sees only the walls.
-pub fn floor_in_black_walls() -> Scene {
-    let light = spot(Vec3::new(0.0, 1.5, 0.0), Vec3::ZERO, 4.0, 30.0, 40.0);
-    let camera = Camera::look_at(
-        Vec3::new(0.0, 1.8, 1.2),
-        Vec3::new(0.0, 0.2, -0.3),
-        Vec3::Y,
-        70f32.to_radians(),
-        0.01,
-    );
-    let mut s = floor_scene(light, camera, 1.0, 0.5);
-    let black = s.add_material("black", Vec3::ZERO);
-    for inward in [Vec3::X, -Vec3::X, Vec3::Z, -Vec3::Z] {
-        // Counter-clockwise seen from inside: along Y x inward, then up.
-        let (c, d) = (-inward, Vec3::Y.cross(inward));
-        s.add_quad(
-            "wall",
-            [c - d, c + d, c + d + Vec3::Y, c - d + Vec3::Y],
-            black,
-        );
-    }
     s
 }
 
