@@ -32,18 +32,7 @@ fn rendered_and_traced(
 ) -> (Rendered, Readback, TruthMask) {
     let settings = sized("none", n, n, rsm);
     let rendered = render(gpu, scene, &settings, 1);
-    let traced = isr::pathtrace::render(
-        scene,
-        &isr::pathtrace::PathTraceSettings {
-            width: n,
-            height: n,
-            spp: 1,
-            seed: 1,
-            exposure: 1.0,
-            bounces: isr::bounces::Bounces::ONE,
-        },
-        |_, _| {},
-    );
+    let traced = common::traced::traced_once(scene, n, n);
     let shadows = ShadowMaps::new(
         &rendered.light_views,
         rendered.origin,

@@ -54,18 +54,7 @@ fn error_and_truth(
         ..sized("none", n, n, 64)
     };
     let raster = render(gpu, scene, &settings, 1).readback;
-    let traced = isr::pathtrace::render(
-        scene,
-        &isr::pathtrace::PathTraceSettings {
-            width: n,
-            height: n,
-            spp: 1,
-            seed: 1,
-            exposure: 1.0,
-            bounces: isr::bounces::Bounces::ONE,
-        },
-        |_, _| {},
-    );
+    let traced = common::traced::traced_once(scene, n, n);
     (0..(n * n) as usize)
         .map(|k| {
             let seen = raster.position[k][3] > 0.0;

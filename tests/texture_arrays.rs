@@ -7,7 +7,6 @@ mod common;
 use common::*;
 use glam::{Vec2, Vec3};
 use isr::frame::texture_arrays::{self, ARRAYS};
-use isr::pathtrace::PathTraceSettings;
 use isr::renderer::Renderer;
 use isr::scene::{Scene, Texture};
 
@@ -187,18 +186,7 @@ fn each_texture_of_many_sizes_shows_where_it_is_mapped() {
     let out = r.readback().unwrap();
     drop(r);
     assert_validation_clean(&gpu);
-    let traced = isr::pathtrace::render(
-        &scene,
-        &PathTraceSettings {
-            width,
-            height,
-            spp: 1,
-            seed: 1,
-            exposure: 1.0,
-            bounces: isr::bounces::Bounces::ONE,
-        },
-        |_, _| {},
-    );
+    let traced = common::traced::traced_once(&scene, width, height);
     for (who, r) in [("G-buffer", &out), ("path tracer", &traced)] {
         let errors = albedo_errors(&r.position, &r.albedo, &sampled);
         for (i, &(pixels, error)) in errors.iter().enumerate() {

@@ -23,6 +23,7 @@ pub mod grid;
 pub mod measure;
 pub mod sibenik;
 pub mod sphere;
+pub mod traced;
 
 // Every test binary compiles this kit; most use no grid helper.
 #[allow(unused_imports)]
