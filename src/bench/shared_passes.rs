@@ -4,7 +4,7 @@
 //! method's indirect time reads against it. The shadow map is drawn apart
 //! from the RSM (docs/algorithm.md section 2.2) and shows its own cost here.
 
-use super::rows::{pass_names, Row};
+use super::rows::Row;
 use super::Plan;
 
 /// The median of `v` (not empty).
@@ -18,16 +18,20 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// The passes timed in every row of `rows` (in first appearance), with the
-/// median over the rows of each one's time (ms); empty without rows.
+/// The passes timed in every row of `rows` (those of the first, by name),
+/// with the median over the rows of each one's time (ms); empty without
+/// rows.
 fn shared(rows: &[&Row]) -> Vec<(String, f64)> {
-    let owned: Vec<Row> = rows.iter().map(|&r| r.clone()).collect();
-    pass_names(&owned)
-        .into_iter()
-        .filter(|p| rows.iter().all(|r| r.passes.contains_key(p)))
+    let Some(first) = rows.first() else {
+        return vec![];
+    };
+    first
+        .passes
+        .keys()
+        .filter(|p| rows.iter().all(|r| r.passes.contains_key(*p)))
         .map(|p| {
-            let ms = median(rows.iter().map(|r| r.passes[&p]).collect());
-            (p, ms)
+            let ms = median(rows.iter().map(|r| r.passes[p]).collect());
+            (p.clone(), ms)
         })
         .collect()
 }
