@@ -351,7 +351,8 @@ per bounce (over the compared pixels):\n\n\
     }
     md += "\nEach method that renders bounces, at its default point and visibility, with each bounces \
 setting (section 5.9): relative RMSE of the indirect image against the truth of every bounce and \
-against the truth of its own bounces; the light its bounces 2..N add over what they add in the truth \
+against the truth of its own bounces, over the pixels away from geometric and shadow edges (the truth's \
+mask); the light its bounces 2..N add over what they add in the truth \
 (`(I_N - I_1) / (T_N - T_1)`, summed over the compared pixels; 1: as much); the median \
 indirect ms and, in it, the bounce passes' median ms each.\n\n\
 | scene | method | setting | bounces | RMSE every bounce | RMSE own bounces | extra light | indirect ms | bounce passes (ms) |\n\
@@ -424,8 +425,8 @@ pub fn headline(rows: &[Row]) -> String {
         .text();
     let mut md = format!(
         "\nEvery bounce (the bounces axis, at the middle animation frame, each method at its default with \
-the grid): the relative RMSE of the indirect image against the path-traced truth of every bounce with one \
-bounce, then with every bounce (`--bounces inf`); and the indirect time with every bounce. The default, \
+the grid): the relative RMSE of the indirect image against the path-traced truth of every bounce, over the \
+pixels away from geometric and shadow edges, with one bounce, then with every bounce (`--bounces inf`); and the indirect time with every bounce. The default, \
 `--bounces {default}`, is the best balance of `hisr`'s settings (docs/results.md, \"Bounces\").\n\n| method |"
     );
     for s in &scenes {
