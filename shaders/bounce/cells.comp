@@ -1,11 +1,13 @@
 #version 460
 // Pass `bounce-cells` (docs/algorithm.md section 5.9): one workgroup per
-// coarse cell. Its threads sum the surface of the finest cells under it
-// (voxel_grid/surface.glsl) into the cell's area, albedo, normal and
-// centroid, then gather the first bounce's irradiance E at the centroid from
-// the regular VPLs of this light view (the patch formula, with the methods'
-// visibility), and the cell re-emits its power P1 = rho E A (shared notes,
-// section 11). Both sums are fixed-order tree reductions: the same every run.
+// coarse cell. Its threads split the surface of the finest cells under it
+// (voxel_grid/surface.glsl) among the cell's six faces by facing
+// (bounce/bounce.glsl) and sum each face's area, albedo, normal and
+// centroid; then gather the first bounce's irradiance E at each face's
+// centroid from the regular VPLs of this light view (the patch formula with
+// the methods' visibility, the face a disc like a patch), and each face
+// re-emits its power P1 = rho E A (shared notes, section 11). Every sum is a
+// fixed-order tree reduction: the same every run.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "lighting.glsl"
@@ -27,6 +29,11 @@ layout(set = 1, binding = 6) uniform sampler2D rsm_flux;
 shared vec4 sum_a[64];
 shared vec4 sum_b[64];
 shared vec4 sum_c[64];
+// The faces, once summed: centroid (world) and area (m^2), unit normal,
+// albedo.
+shared vec4 face_x[BOUNCE_FACES];
+shared vec3 face_n[BOUNCE_FACES];
+shared vec3 face_rho[BOUNCE_FACES];
 
 // Sums sum_a, sum_b, sum_c over the workgroup into their entry 0.
 void reduce() {
@@ -42,6 +49,21 @@ void reduce() {
     barrier();
 }
 
+// Face f's share of a finest cell whose mean normal is m (|m| <= 1): m_k^2
+// where f faces along axis k on m's side, and (1 - |m|^2) / 6 for every face.
+float face_weight(vec3 m, int f) {
+    float mk = m[f / 2];
+    bool along = (f % 2 == 0) ? mk > 0.0 : mk < 0.0;
+    return (along ? mk * mk : 0.0) + max(1.0 - dot(m, m), 0.0) / float(BOUNCE_FACES);
+}
+
+// The unit normal of face f: its axis, toward its side.
+vec3 face_axis(int f) {
+    vec3 n = vec3(0.0);
+    n[f / 2] = (f % 2 == 0) ? 1.0 : -1.0;
+    return n;
+}
+
 void main() {
     uint c = gl_WorkGroupID.x;
     uint t = gl_LocalInvocationIndex;
@@ -49,52 +71,102 @@ void main() {
     int per = side / BOUNCE_SIDE;  // finest cells per coarse side
     ivec3 cc = ivec3(int(c) % BOUNCE_SIDE, (int(c) / BOUNCE_SIDE) % BOUNCE_SIDE,
                      int(c) / (BOUNCE_SIDE * BOUNCE_SIDE));
-    // Fixed-point sums, in finest-cell units: area, albedo x area, normal x
-    // area, place x area.
-    float area = 0.0;
-    vec3 rho = vec3(0.0), nrm = vec3(0.0), place = vec3(0.0);
+    // Per face, in finest-cell units: area, albedo x area, normal x area,
+    // place x area.
+    float area[BOUNCE_FACES];
+    vec3 rho[BOUNCE_FACES], nrm[BOUNCE_FACES], place[BOUNCE_FACES];
+    for (int f = 0; f < BOUNCE_FACES; ++f) {
+        area[f] = 0.0;
+        rho[f] = nrm[f] = place[f] = vec3(0.0);
+    }
     for (int k = int(t); k < per * per * per; k += 64) {
-        ivec3 f = cc * per + ivec3(k % per, (k / per) % per, k / (per * per));
-        uint base = SURFACE_WORDS * uint(f.x + side * (f.y + side * f.z));
+        ivec3 g = cc * per + ivec3(k % per, (k / per) % per, k / (per * per));
+        uint base = SURFACE_WORDS * uint(g.x + side * (g.y + side * g.z));
         float a = float(surface[base]);
-        area += a;
-        rho += vec3(surface[base + 1u], surface[base + 2u], surface[base + 3u]);
-        nrm += vec3(int(surface[base + 4u]), int(surface[base + 5u]), int(surface[base + 6u]));
-        place += vec3(surface[base + 7u], surface[base + 8u], surface[base + 9u]) + vec3(f) * a;
-    }
-    sum_a[t] = vec4(place, area);
-    sum_b[t] = vec4(rho, 0.0);
-    sum_c[t] = vec4(nrm, 0.0);
-    reduce();
-    area = sum_a[0].w;
-    vec4 g = u.grid_cube;
-    vec3 x = g.xyz + sum_a[0].xyz / max(area, 1e-30) * g.w;
-    vec3 albedo = sum_b[0].rgb / max(area, 1e-30);
-    vec3 mean_n = sum_c[0].xyz / max(area, 1e-30);
-    float len = length(mean_n);
-    vec3 n = len > 0.0 ? mean_n / len : vec3(0.0, 1.0, 0.0);
-    float world_area = area / SURFACE_ONE * g.w * g.w;
-    // The first bounce at the centroid, the VPLs shared among the threads.
-    vec3 e = vec3(0.0);
-    if (area > 0.0) {
-        for (int j = int(t); j < regular_vpl_count(); j += 64) {
-            vec4 pos, vn;
-            vec3 flux;
-            if (regular_vpl(j, pos, vn, flux)) e += patch_irradiance(x, n, pos.xyz, vn.xyz, flux, pos.w, int(vn.w));
+        if (a <= 0.0) continue;
+        vec3 r = vec3(surface[base + 1u], surface[base + 2u], surface[base + 3u]);
+        vec3 m = vec3(int(surface[base + 4u]), int(surface[base + 5u]), int(surface[base + 6u])) / a;
+        float len = length(m);
+        vec3 unit = len > 0.0 ? m / len : vec3(0.0);
+        float folded = max(1.0 - dot(m, m), 0.0) / float(BOUNCE_FACES);
+        vec3 x = vec3(surface[base + 7u], surface[base + 8u], surface[base + 9u]) + vec3(g) * a;
+        // Unrolled by hand: six faces, no loop for lavapipe's count.
+#define BOUNCE_ADD_FACE(f)                                                      \
+        {                                                                       \
+            float w = face_weight(m, f);                                        \
+            area[f] += a * w;                                                   \
+            rho[f] += r * w;                                                    \
+            nrm[f] += a * ((w - folded) * unit + folded * face_axis(f));        \
+            place[f] += x * w;                                              \
         }
+        BOUNCE_ADD_FACE(0) BOUNCE_ADD_FACE(1) BOUNCE_ADD_FACE(2)
+        BOUNCE_ADD_FACE(3) BOUNCE_ADD_FACE(4) BOUNCE_ADD_FACE(5)
+#undef BOUNCE_ADD_FACE
     }
-    barrier();
-    sum_a[t] = vec4(e, 0.0);
-    sum_b[t] = vec4(0.0);
-    sum_c[t] = vec4(0.0);
-    reduce();
+    vec4 g = u.grid_cube;
+    for (int f = 0; f < BOUNCE_FACES; ++f) {
+        sum_a[t] = vec4(place[f], area[f]);
+        sum_b[t] = vec4(rho[f], 0.0);
+        sum_c[t] = vec4(nrm[f], 0.0);
+        reduce();
+        if (t == 0u) {
+            float a = sum_a[0].w;
+            float inv = 1.0 / max(a, 1e-30);
+            vec3 n = sum_c[0].xyz;
+            face_x[f] = vec4(g.xyz + sum_a[0].xyz * inv * g.w, a / SURFACE_ONE * g.w * g.w);
+            face_n[f] = length(n) > 0.0 ? normalize(n) : face_axis(f);
+            face_rho[f] = sum_b[0].rgb * inv;
+        }
+        barrier();
+    }
+    // The first bounce at each face's centroid, the VPLs shared among the
+    // threads. The face's end of a march is skipped like a patch's (its
+    // disc's radius over its plane): its centroid lies off its surfaces by
+    // up to about that.
+    vec3 e[BOUNCE_FACES];
+    for (int f = 0; f < BOUNCE_FACES; ++f) e[f] = vec3(0.0);
+    for (int j = int(t); j < regular_vpl_count(); j += 64) {
+        vec4 pos, vn;
+        vec3 flux;
+        if (!regular_vpl(j, pos, vn, flux)) continue;
+#define BOUNCE_FIRST(f)                                                                      \
+        if (face_x[f].w > 0.0) {                                                             \
+            vec3 x = face_x[f].xyz, n = face_n[f];                                           \
+            vec3 k = patch_unshadowed(x, n, pos.xyz, vn.xyz, flux, pos.w, int(vn.w));        \
+            if (VOXEL_VISIBILITY) {                                                          \
+                float t0 = 1.0 - voxel_patch_skip(pos.xyz, x, n, face_x[f].w);               \
+                k *= voxel_march(x, pos.xyz, t0, voxel_patch_skip(x, pos.xyz, vn.xyz, pos.w)); \
+            }                                                                                \
+            e[f] += k;                                                                       \
+        }
+        BOUNCE_FIRST(0) BOUNCE_FIRST(1) BOUNCE_FIRST(2)
+        BOUNCE_FIRST(3) BOUNCE_FIRST(4) BOUNCE_FIRST(5)
+#undef BOUNCE_FIRST
+    }
+    // Two reductions of three faces each.
+    vec3 irradiance[BOUNCE_FACES];
+    for (int h = 0; h < 2; ++h) {
+        sum_a[t] = vec4(e[3 * h], 0.0);
+        sum_b[t] = vec4(e[3 * h + 1], 0.0);
+        sum_c[t] = vec4(e[3 * h + 2], 0.0);
+        reduce();
+        irradiance[3 * h] = sum_a[0].rgb;
+        irradiance[3 * h + 1] = sum_b[0].rgb;
+        irradiance[3 * h + 2] = sum_c[0].rgb;
+        barrier();
+    }
     if (t == 0u) {
-        uint i = uint(BOUNCE_CELL_VEC4S) * c;
-        cells[i] = vec4(x, world_area);
-        cells[i + 1u] = vec4(n, len);
-        cells[i + 2u] = vec4(albedo, 0.0);
-        vec4 p = vec4(albedo * sum_a[0].rgb * world_area, 0.0);
-        power[c] = p;
-        power_sum[c] = p;
+        vec4 all_ = vec4(0.0);
+        for (int f = 0; f < BOUNCE_FACES; ++f) {
+            int i = bounce_face(int(c), f);
+            cells[i] = face_x[f];
+            cells[i + 1] = vec4(face_n[f], 0.0);
+            cells[i + 2] = vec4(face_rho[f], 0.0);
+            vec4 p = vec4(face_rho[f] * irradiance[f] * face_x[f].w, 0.0);
+            power[BOUNCE_FACES * int(c) + f] = p;
+            power_sum[BOUNCE_FACES * int(c) + f] = p;
+            all_ += vec4(face_x[f].xyz * face_x[f].w, face_x[f].w);
+        }
+        cells[BOUNCE_CELL_VEC4S * int(c)] = vec4(all_.xyz / max(all_.w, 1e-30), all_.w);
     }
 }

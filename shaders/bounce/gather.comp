@@ -1,9 +1,10 @@
 #version 460
 // Pass `bounce-gather` (docs/algorithm.md section 5.9): receivers at one
 // pixel of each BOUNCE_STEP x BOUNCE_STEP block (its centre) gather bounces
-// 2..N from every coarse cell's power summed over bounces 1..N-1, the patch
-// formula with the cell's mean normal (a wall is not lit from behind) and
-// the methods' visibility. Writes one irradiance per block.
+// 2..N from every cell face's power summed over bounces 1..N-1, the patch
+// formula with the face's mean normal (a wall is not lit from behind) and
+// the methods' visibility, the face a disc like a patch. Writes one
+// irradiance per block.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "lighting.glsl"
@@ -28,9 +29,18 @@ void main() {
     vec3 e = vec3(0.0);
     if (p.w > 0.0) {
         vec3 n = normalize(texelFetch(gbuffer_normal, pixel, 0).xyz);
-        for (int j = 0; j < BOUNCE_CELLS; ++j) {
-            vec4 c = cells[BOUNCE_CELL_VEC4S * j];
-            if (c.w > 0.0) e += patch_irradiance(p.xyz, n, c.xyz, cells[BOUNCE_CELL_VEC4S * j + 1].xyz, power_sum[j].rgb, c.w, 0);
+        // One loop over every face (the cell's and face's indices from one
+        // counter): a loop per cell and one per face inside it would count
+        // both toward lavapipe's 65,535 iterations.
+        for (int k = 0; k < BOUNCE_PATCHES; ++k) {
+            int j = k / BOUNCE_FACES;
+            if (cells[BOUNCE_CELL_VEC4S * j].w <= 0.0) {
+                k += BOUNCE_FACES - 1 - k % BOUNCE_FACES;  // the cell is empty: past its faces
+                continue;
+            }
+            int i = bounce_face(j, k % BOUNCE_FACES);
+            vec4 f = cells[i];
+            if (f.w > 0.0) e += patch_irradiance(p.xyz, n, f.xyz, cells[i + 1].xyz, power_sum[k].rgb, f.w, 0);
         }
     }
     received[q.x + low.x * q.y] = vec4(e, 0.0);

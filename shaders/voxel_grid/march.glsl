@@ -59,26 +59,20 @@ const int VISIBILITY_MAX_ITERATIONS = 13;
 // section 5, "Sub-cells").
 const int VISIBILITY_SAMPLES = 4;
 
-// The visibility of the segment xi -> xj outside the two ends' skipped parts:
-// 1 where it crosses no occupied sub-cell, 0 where it runs at least
-// VISIBILITY_OPAQUE_CHORD cells through them, linear between. ni, nj: unit
-// normals of the receiver and the patch (the rise over each one's plane is
-// where the contribution is not 0); aj the patch's area. A hierarchical DDA:
+// The visibility of the part t0..t1 of the segment xi -> xj (fractions of
+// it from xi): 1 where it crosses no occupied sub-cell, 0 where it runs at
+// least VISIBILITY_OPAQUE_CHORD cells through them, linear between. A
+// hierarchical DDA:
 // at each point, the coarsest level whose cell there is empty is skipped
 // whole (found from level 1 up); an occupied cell is entered one level finer;
 // an occupied finest cell adds its chord times the fraction of
 // VISIBILITY_SAMPLES points evenly along the chord that lie in occupied
 // sub-cells; after leaving a cell the march climbs a level only where it also
 // left the parent cell.
-float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
+float voxel_march(vec3 xi, vec3 xj, float t0, float t1) {
     vec4 g = u.grid_cube;
     vec3 a = (xi - g.xyz) / g.w;  // in finest cells
     vec3 d = (xj - xi) / g.w;
-    float rise_i = dot(d, ni);    // the patch's height over the receiver's plane
-    float rise_j = -dot(d, nj);   // the receiver's height over the patch's plane
-    float t0 = VISIBILITY_END_SKIP / max(rise_i, 1e-30);
-    float skip_j = clamp(sqrt(aj / PI) / g.w, VISIBILITY_END_SKIP, VISIBILITY_PATCH_SKIP);
-    float t1 = 1.0 - skip_j / max(rise_j, 1e-30);
     // No zero components: the exit distances below stay finite and ordered.
     vec3 ds = mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
     vec3 inv = 1.0 / ds;
@@ -169,6 +163,31 @@ float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
 #undef VISIBILITY_STEP
 #undef VISIBILITY_SAMPLE
     return clamp(1.0 - inside / VISIBILITY_OPAQUE_CHORD, 0.0, 1.0);
+}
+
+// Where the march of xi -> xj starts, as a fraction of the segment: past
+// the receiver's skip (VISIBILITY_END_SKIP over the receiver's plane; ni its
+// unit normal, the rise over its plane being where the contribution is not 0).
+float voxel_receiver_skip(vec3 xi, vec3 ni, vec3 xj) {
+    float rise_i = dot((xj - xi) / u.grid_cube.w, ni);
+    return VISIBILITY_END_SKIP / max(rise_i, 1e-30);
+}
+
+// Where the march of xi -> xj ends, as a fraction of the segment: short of
+// the patch's skip (its disc's radius over its plane; nj its unit normal, aj
+// its area).
+float voxel_patch_skip(vec3 xi, vec3 xj, vec3 nj, float aj) {
+    float rise_j = -dot((xj - xi) / u.grid_cube.w, nj);
+    float skip_j = clamp(sqrt(aj / PI) / u.grid_cube.w, VISIBILITY_END_SKIP, VISIBILITY_PATCH_SKIP);
+    return 1.0 - skip_j / max(rise_j, 1e-30);
+}
+
+// The visibility of the segment xi -> xj outside the two ends' skipped parts:
+// 1 where it crosses no occupied sub-cell, 0 where it runs at least
+// VISIBILITY_OPAQUE_CHORD cells through them, linear between. ni, nj: unit
+// normals of the receiver and the patch; aj the patch's area.
+float voxel_visibility(vec3 xi, vec3 ni, vec3 xj, vec3 nj, float aj) {
+    return voxel_march(xi, xj, voxel_receiver_skip(xi, ni, xj), voxel_patch_skip(xi, xj, nj, aj));
 }
 
 #endif

@@ -4,18 +4,19 @@
 //! indirect irradiance a method wrote. Its carrier is the voxel grid's
 //! surface (`voxel_grid::surface`), so it reaches surfaces the light does
 //! not see: the grid's finest cells are merged into [`SIDE`]^3 coarse cells,
-//! each a piece of surface with an area, albedo, mean normal and centroid.
+//! and each cell's surface split by facing into [`FACES`] faces, each a
+//! piece of surface with an area, albedo, mean normal and centroid.
 //! Every frame, per light view, nothing kept between frames:
 //!
-//! 1. `bounce-cells`: each cell's surface, and the first bounce's
-//!    irradiance E at its centroid from [`VPLS`] regular VPLs of the RSM; it
-//!    re-emits rho E A watts.
-//! 2. `bounce-transfer`: the irradiance every cell gets per watt from every
-//!    other (the patch formula with the run's visibility), once a frame.
-//! 3. `bounce-propagate`: bounces 2..N-1 among the cells (`inf`: until a
+//! 1. `bounce-cells`: each cell's faces, and the first bounce's
+//!    irradiance E at each face's centroid from [`VPLS`] regular VPLs of the
+//!    RSM; a face re-emits rho E A watts.
+//! 2. `bounce-transfer`: the visibility between every two cells (the run's
+//!    visibility), once a frame.
+//! 3. `bounce-propagate`: bounces 2..N-1 among the faces (`inf`: until a
 //!    bounce brings under 1% of the power so far, at most [`INFINITE_CAP`]).
 //! 4. `bounce-gather`: receivers at one pixel in [`STEP`] x [`STEP`] gather
-//!    the cells' power summed over bounces 1..N-1, which is bounces 2..N at
+//!    the faces' power summed over bounces 1..N-1, which is bounces 2..N at
 //!    the receiver.
 //! 5. `bounce-add`: upsampled (joint bilateral) and added to `indirect`.
 //!
@@ -69,8 +70,14 @@ pub fn check(s: &RenderSettings) -> Result<()> {
 pub const SIDE: u32 = 8;
 /// Coarse cells in all.
 pub const CELLS: u32 = SIDE * SIDE * SIDE;
-/// Bytes per cell: three vec4s (`shaders/bounce/bounce.glsl`).
-const CELL_BYTES: u64 = 48;
+/// Faces per cell: its surface split by facing, one per axis direction
+/// (`shaders/bounce/bounce.glsl`).
+pub const FACES: u32 = 6;
+/// Bytes per cell: a vec4 for the cell and three per face
+/// (`shaders/bounce/bounce.glsl`).
+const CELL_BYTES: u64 = 16 * (1 + 3 * FACES as u64);
+/// Bytes of a power per face: a vec4 each.
+const POWER_BYTES: u64 = CELLS as u64 * FACES as u64 * 16;
 /// Receivers: one pixel per `STEP` x `STEP` block, upsampled.
 pub const STEP: u32 = 4;
 /// The regular VPLs each cell gathers its first bounce from (fewer where
@@ -98,7 +105,8 @@ pub fn active(s: &RenderSettings) -> bool {
 }
 
 /// Bytes of the buffers of the bounce passes for `s` (0 with one bounce):
-/// the cells, three powers, the transfer between every pair of cells, and
+/// the cells, three powers per face, the visibility between every pair of
+/// cells, and
 /// the receivers; with feedback a power per light view, counted for the
 /// most views a frame renders (`MAX_LIGHT_VIEWS`: 512 KiB at most).
 pub fn memory(s: &RenderSettings) -> u64 {
@@ -111,11 +119,11 @@ pub fn memory(s: &RenderSettings) -> u64 {
         true => crate::frame::check::MAX_LIGHT_VIEWS as u64 * HISTORY_BYTES,
         false => 0,
     };
-    cells * CELL_BYTES + 3 * cells * 16 + cells * cells * 4 + receivers * 16 + 16 + history
+    cells * CELL_BYTES + 3 * POWER_BYTES + cells * cells * 4 + receivers * 16 + 16 + history
 }
 
-/// Bytes of one light view's kept power with feedback: a vec4 per cell.
-const HISTORY_BYTES: u64 = CELLS as u64 * 16;
+/// Bytes of one light view's kept power with feedback: a vec4 per face.
+const HISTORY_BYTES: u64 = POWER_BYTES;
 
 #[cfg(test)]
 mod tests {

@@ -8,7 +8,7 @@
 //! views' kept powers are zeroed once, before the run's first frame reads
 //! them, behind the same barriers.
 
-use super::{feedback, propagations, CELLS, CELL_BYTES, HISTORY_BYTES, STEP, VPLS};
+use super::{feedback, propagations, CELLS, CELL_BYTES, HISTORY_BYTES, POWER_BYTES, STEP, VPLS};
 use crate::bounces::{Bounces, BOUNCES};
 use crate::frame::{FrameContext, Setup};
 use crate::passes::{ComputePass, INDIRECT_COMPUTE};
@@ -71,10 +71,10 @@ impl BouncePass {
         let (gpu, s, t) = (setup.gpu, setup.settings, setup.targets);
         let cells_n = CELLS as u64;
         let cells = storage(gpu, "cells", cells_n * CELL_BYTES)?;
-        let power_a = storage(gpu, "power", cells_n * 16)?;
-        let power_b = storage(gpu, "power (next)", cells_n * 16)?;
-        let power_sum = storage(gpu, "power summed", cells_n * 16)?;
-        let transfer = storage(gpu, "transfer", cells_n * cells_n * 4)?;
+        let power_a = storage(gpu, "power", POWER_BYTES)?;
+        let power_b = storage(gpu, "power (next)", POWER_BYTES)?;
+        let power_sum = storage(gpu, "power summed", POWER_BYTES)?;
+        let transfer = storage(gpu, "visibility", cells_n * cells_n * 4)?;
         let low = (s.width.div_ceil(STEP), s.height.div_ceil(STEP));
         let received = storage(gpu, "receivers", low.0 as u64 * low.1 as u64 * 16)?;
         let state = storage(gpu, "state", 16)?;
@@ -129,9 +129,13 @@ impl BouncePass {
             &[ping_pong(&power_a, &power_b), ping_pong(&power_b, &power_a)],
             0,
             &[
-                step,
-                Spec::bool("BOUNCE_INFINITE", BOUNCES.get(s) == Bounces::Infinite),
-            ],
+                &vis[..],
+                &[Spec::bool(
+                    "BOUNCE_INFINITE",
+                    BOUNCES.get(s) == Bounces::Infinite,
+                )],
+            ]
+            .concat(),
         )?;
         let gbuffer = |b: &mut Vec<Binding>| {
             b.push(Binding::sampled(
@@ -167,7 +171,7 @@ impl BouncePass {
                     "bounce/feedback.comp",
                     &sets,
                     0,
-                    &[step],
+                    &vis,
                 )?;
                 Some(Feedback {
                     pass,
