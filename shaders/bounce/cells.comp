@@ -15,7 +15,10 @@
 #include "voxel_grid/surface.glsl"
 #include "bounce/bounce.glsl"
 
-layout(local_size_x = 64) in;
+// Few threads, so that one shared array holds every sum at once and each
+// reduction is one tree (a barrier per level): lavapipe runs barriers slowly.
+const uint THREADS = 32u;
+layout(local_size_x = THREADS) in;
 
 layout(set = 1, binding = 0, std430) readonly buffer GridSurface { uint surface[]; };
 layout(set = 1, binding = 1, std430) writeonly buffer BounceCells { vec4 cells[]; };
@@ -26,24 +29,24 @@ layout(set = 1, binding = 5) uniform sampler2D rsm_normal;
 layout(set = 1, binding = 6) uniform sampler2D rsm_flux;
 #include "regular_vpls/regular_vpls.glsl"
 
-shared vec4 sum_a[64];
-shared vec4 sum_b[64];
-shared vec4 sum_c[64];
+// What each thread sums, REDUCED vec4s per thread: per face its place and
+// area, albedo, normal (3 BOUNCE_FACES vec4s); later its first bounce.
+const uint REDUCED = 3u * uint(BOUNCE_FACES);
+shared vec4 sums[THREADS * REDUCED];
 // The faces, once summed: centroid (world) and area (m^2), unit normal,
 // albedo.
 shared vec4 face_x[BOUNCE_FACES];
 shared vec3 face_n[BOUNCE_FACES];
 shared vec3 face_rho[BOUNCE_FACES];
 
-// Sums sum_a, sum_b, sum_c over the workgroup into their entry 0.
-void reduce() {
+// Sums the first n vec4s of every thread's slice of `sums` over the
+// workgroup into thread 0's slice: a fixed-order tree.
+void reduce(uint n) {
     uint t = gl_LocalInvocationIndex;
-    for (uint stride = 32u; stride > 0u; stride >>= 1u) {
+    for (uint stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
         barrier();
         if (t < stride) {
-            sum_a[t] += sum_a[t + stride];
-            sum_b[t] += sum_b[t + stride];
-            sum_c[t] += sum_c[t + stride];
+            for (uint k = 0u; k < n; ++k) sums[t * REDUCED + k] += sums[(t + stride) * REDUCED + k];
         }
     }
     barrier();
@@ -79,7 +82,7 @@ void main() {
         area[f] = 0.0;
         rho[f] = nrm[f] = place[f] = vec3(0.0);
     }
-    for (int k = int(t); k < per * per * per; k += 64) {
+    for (int k = int(t); k < per * per * per; k += int(THREADS)) {
         ivec3 g = cc * per + ivec3(k % per, (k / per) % per, k / (per * per));
         uint base = SURFACE_WORDS * uint(g.x + side * (g.y + side * g.z));
         float a = float(surface[base]);
@@ -105,27 +108,28 @@ void main() {
     }
     vec4 g = u.grid_cube;
     for (int f = 0; f < BOUNCE_FACES; ++f) {
-        sum_a[t] = vec4(place[f], area[f]);
-        sum_b[t] = vec4(rho[f], 0.0);
-        sum_c[t] = vec4(nrm[f], 0.0);
-        reduce();
-        if (t == 0u) {
-            float a = sum_a[0].w;
-            float inv = 1.0 / max(a, 1e-30);
-            vec3 n = sum_c[0].xyz;
-            face_x[f] = vec4(g.xyz + sum_a[0].xyz * inv * g.w, a / SURFACE_ONE * g.w * g.w);
-            face_n[f] = length(n) > 0.0 ? normalize(n) : face_axis(f);
-            face_rho[f] = sum_b[0].rgb * inv;
-        }
-        barrier();
+        sums[t * REDUCED + 3u * uint(f)] = vec4(place[f], area[f]);
+        sums[t * REDUCED + 3u * uint(f) + 1u] = vec4(rho[f], 0.0);
+        sums[t * REDUCED + 3u * uint(f) + 2u] = vec4(nrm[f], 0.0);
     }
+    reduce(REDUCED);
+    if (t < uint(BOUNCE_FACES)) {
+        uint f = t;
+        vec4 xa = sums[3u * f];
+        float inv = 1.0 / max(xa.w, 1e-30);
+        vec3 n = sums[3u * f + 2u].xyz;
+        face_x[f] = vec4(g.xyz + xa.xyz * inv * g.w, xa.w / SURFACE_ONE * g.w * g.w);
+        face_n[f] = length(n) > 0.0 ? normalize(n) : face_axis(int(f));
+        face_rho[f] = sums[3u * f + 1u].rgb * inv;
+    }
+    barrier();
     // The first bounce at each face's centroid, the VPLs shared among the
     // threads. The face's end of a march is skipped like a patch's (its
     // disc's radius over its plane): its centroid lies off its surfaces by
     // up to about that.
     vec3 e[BOUNCE_FACES];
     for (int f = 0; f < BOUNCE_FACES; ++f) e[f] = vec3(0.0);
-    for (int j = int(t); j < regular_vpl_count(); j += 64) {
+    for (int j = int(t); j < regular_vpl_count(); j += int(THREADS)) {
         vec4 pos, vn;
         vec3 flux;
         if (!regular_vpl(j, pos, vn, flux)) continue;
@@ -143,18 +147,10 @@ void main() {
         BOUNCE_FIRST(3) BOUNCE_FIRST(4) BOUNCE_FIRST(5)
 #undef BOUNCE_FIRST
     }
-    // Two reductions of three faces each.
+    for (int f = 0; f < BOUNCE_FACES; ++f) sums[t * REDUCED + uint(f)] = vec4(e[f], 0.0);
+    reduce(uint(BOUNCE_FACES));
     vec3 irradiance[BOUNCE_FACES];
-    for (int h = 0; h < 2; ++h) {
-        sum_a[t] = vec4(e[3 * h], 0.0);
-        sum_b[t] = vec4(e[3 * h + 1], 0.0);
-        sum_c[t] = vec4(e[3 * h + 2], 0.0);
-        reduce();
-        irradiance[3 * h] = sum_a[0].rgb;
-        irradiance[3 * h + 1] = sum_b[0].rgb;
-        irradiance[3 * h + 2] = sum_c[0].rgb;
-        barrier();
-    }
+    for (int f = 0; f < BOUNCE_FACES; ++f) irradiance[f] = sums[f].rgb;
     if (t == 0u) {
         vec4 all_ = vec4(0.0);
         for (int f = 0; f < BOUNCE_FACES; ++f) {
