@@ -124,7 +124,7 @@ void main() {
     }
     barrier();
     // The first bounce at each face's centroid, the VPLs shared among the
-    // threads. The face's end of a march is skipped like a patch's (its
+    // threads, marched only where the VPL lights the face at all. The face's end of a march is skipped like a patch's (its
     // disc's radius over its plane): its centroid lies off its surfaces by
     // up to about that.
     vec3 e[BOUNCE_FACES];
@@ -137,7 +137,7 @@ void main() {
         if (face_x[f].w > 0.0) {                                                             \
             vec3 x = face_x[f].xyz, n = face_n[f];                                           \
             vec3 k = patch_unshadowed(x, n, pos.xyz, vn.xyz, flux, pos.w, int(vn.w));        \
-            if (VOXEL_VISIBILITY) {                                                          \
+            if (VOXEL_VISIBILITY && k != vec3(0.0)) {                                        \
                 float t0 = 1.0 - voxel_patch_skip(pos.xyz, x, n, face_x[f].w);               \
                 k *= voxel_march(x, pos.xyz, t0, voxel_patch_skip(x, pos.xyz, vn.xyz, pos.w)); \
             }                                                                                \
