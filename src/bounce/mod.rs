@@ -82,7 +82,7 @@ const POWER_BYTES: u64 = CELLS as u64 * FACES as u64 * 16;
 pub const STEP: u32 = 4;
 /// The regular VPLs each cell gathers its first bounce from (fewer where
 /// the RSM has fewer texels).
-pub const VPLS: u32 = 256;
+pub const VPLS: u32 = 1024;
 /// The most bounces `--bounces inf` computes before it stops: where a room
 /// keeps 0.9 of its light per bounce, the 1% test ends it near 40.
 pub const INFINITE_CAP: u32 = 64;
