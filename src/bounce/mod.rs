@@ -119,7 +119,7 @@ pub fn memory(s: &RenderSettings) -> u64 {
         true => crate::frame::check::MAX_LIGHT_VIEWS as u64 * HISTORY_BYTES,
         false => 0,
     };
-    cells * CELL_BYTES + 3 * POWER_BYTES + cells * cells * 4 + receivers * 16 + 16 + history
+    cells * CELL_BYTES + 3 * POWER_BYTES + cells * cells * 4 + receivers * 16 + 32 + history
 }
 
 /// Bytes of one light view's kept power with feedback: a vec4 per face.

@@ -77,7 +77,7 @@ impl BouncePass {
         let transfer = storage(gpu, "visibility", cells_n * cells_n * 4)?;
         let low = (s.width.div_ceil(STEP), s.height.div_ceil(STEP));
         let received = storage(gpu, "receivers", low.0 as u64 * low.1 as u64 * 16)?;
-        let state = storage(gpu, "state", 16)?;
+        let state = storage(gpu, "state", 32)?;
         // Every shader includes bounce/bounce.glsl, which declares it.
         let step = Spec::int("BOUNCE_STEP", STEP as i32);
         let vis = [&visibility::specialization(s)[..], &[step]].concat();
