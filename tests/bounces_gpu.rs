@@ -89,11 +89,11 @@ fn inside_a_closed_sphere_each_bounce_adds_rho_to_the_k() {
 const PER_BOUNCE: f64 = 0.03;
 
 /// Every bounce at once: the per-bounce loss above compounds through the
-/// series (at rho 0.8, 0.984 rho sums to 7.5% less than rho); the series
-/// stops once a bounce adds under 1% and its geometric tail is added.
-/// Measured 5.8% short in red, 1.9% in green, 0.8% in blue (8.5% in red
-/// without the tail). 9% allows half as much again.
-const EVERY: f64 = 0.09;
+/// series (at rho 0.8, 0.984 rho sums to 7.5% less than rho), and the 1%
+/// test stops it with a tail of about 4% left; measured 8.5% short in red,
+/// 1.9% in green, 0.8% in blue. 12% allows the loss per bounce to grow by
+/// a third.
+const EVERY: f64 = 0.12;
 
 /// `--bounces 1` makes no bounce pass, so its frame is the commands (and
 /// the image) of the one-bounce renderer; two bounces add the passes.

@@ -291,6 +291,24 @@ fn flag_constants_match_shared_glsl() {
     assert_eq!(float("PATCH_INVALID"), PATCH_INVALID);
 }
 
+/// The bounce passes' cells (`isr::bounce`) against
+/// `shaders/bounce/bounce.glsl`: the cells per side, the faces per cell and
+/// the vec4s per cell the host sizes the buffers by.
+#[test]
+fn bounce_constants_match_bounce_glsl() {
+    let text = |name: &str| glsl_constant("bounce/bounce.glsl", name);
+    assert_eq!(
+        text("BOUNCE_SIDE").parse::<u32>().unwrap(),
+        isr::bounce::SIDE
+    );
+    assert_eq!(
+        text("BOUNCE_FACES").parse::<u32>().unwrap(),
+        isr::bounce::FACES
+    );
+    assert_eq!(text("BOUNCE_CELL_VEC4S"), "1 + 3 * BOUNCE_FACES");
+    assert_eq!(isr::bounce::CELL_VEC4S, 1 + 3 * isr::bounce::FACES);
+}
+
 /// HISR's constants (`methods::hisr::gpu`) against `shaders/hisr/hisr.glsl`.
 #[test]
 fn hisr_constants_match_hisr_glsl() {

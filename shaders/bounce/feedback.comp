@@ -22,6 +22,8 @@ layout(set = 1, binding = 1, std430) readonly buffer BounceTransfer { float tran
 layout(set = 1, binding = 2, std430) buffer BouncePowerSum { vec4 power_sum[]; };
 // In: this view's S of the last frame (0 before its first); out: this frame's.
 layout(set = 1, binding = 3, std430) buffer BounceHistory { vec4 history[]; };
+// Each face's scale on the power it hands on (bounce-reach).
+layout(set = 1, binding = 4, std430) readonly buffer BounceReach { float reach[]; };
 
 const int PER_THREAD = (BOUNCE_CELLS + 127) / 128;
 
@@ -49,7 +51,7 @@ void main() {
                 }
                 int s = bounce_face(j, a);
                 vec4 xs = cells[s];
-                if (xs.w > 0.0) bounce_receive(e, rx, rn, i == j, a, xs, cells[s + 1].xyz, history[k].rgb, v);
+                if (xs.w > 0.0) bounce_receive(e, rx, rn, i == j, a, xs, cells[s + 1].xyz, history[k].rgb * reach[k], v);
             }
         }
         for (int b = 0; b < BOUNCE_FACES; ++b) {

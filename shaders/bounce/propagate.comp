@@ -3,11 +3,12 @@
 // among the cells' faces, one workgroup for all of them: each face receives
 // E_b = sum over sending faces a of V_ij K_ba P_a from the power every face
 // re-emitted at the previous bounce (V_ij the cells' visibility from
-// bounce-transfer, K_ba the patch formula between the faces as discs) and
+// bounce-transfer, K_ba the patch formula between the faces as discs, P_a
+// scaled by bounce-reach so that no face hands on more than it sends) and
 // re-emits P_b = rho_b E_b A_b, added to its sum over bounces.
 // With BOUNCE_INFINITE (`--bounces inf`) the pass stops the series once a
-// bounce brings under 1% of the power summed so far, adds the geometric tail
-// past it, and later dispatches of the frame find `done` set and return.
+// bounce brings under 1% of the power summed so far: later dispatches of the
+// frame find `done` set and return.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "lighting.glsl"
@@ -20,21 +21,21 @@ layout(constant_id = 81) const bool BOUNCE_INFINITE = false;
 layout(set = 1, binding = 0, std430) readonly buffer BounceCells { vec4 cells[]; };
 layout(set = 1, binding = 1, std430) readonly buffer BounceTransfer { float transfer[]; };
 layout(set = 1, binding = 2, std430) readonly buffer PowerIn { vec4 power_in[]; };
-layout(set = 1, binding = 3, std430) buffer PowerOut { vec4 power_out[]; };
+layout(set = 1, binding = 3, std430) writeonly buffer PowerOut { vec4 power_out[]; };
 layout(set = 1, binding = 4, std430) buffer BouncePowerSum { vec4 power_sum[]; };
-// done: the series has ended this frame; last: the previous bounce's power
-// over every face, per channel (both 0 at the frame's start).
-layout(set = 1, binding = 5, std430) buffer BounceState { uint done; vec4 last; };
+layout(set = 1, binding = 5, std430) buffer BounceState { uint done; };
+// Each face's scale on the power it hands on (bounce-reach).
+layout(set = 1, binding = 6, std430) readonly buffer BounceReach { float reach[]; };
 
 // The share of the summed power under which a bounce ends the series.
 const float BOUNCE_CONVERGED = 0.01;
 
-shared vec4 totals[128];
+shared vec2 totals[128];
 
 void main() {
     if (done != 0u) return;
     uint t = gl_LocalInvocationIndex;
-    vec4 total = vec4(0.0);  // rgb: this bounce's power, a: the sum's (r + g + b)
+    vec2 total = vec2(0.0);  // x: this bounce's power, y: the sum's (r + g + b)
     for (int i = int(t); i < BOUNCE_CELLS; i += 128) {
         if (cells[BOUNCE_CELL_VEC4S * i].w <= 0.0) continue;
         vec4 rx[BOUNCE_FACES];
@@ -55,7 +56,7 @@ void main() {
             }
             int s = bounce_face(j, a);
             vec4 xs = cells[s];
-            if (xs.w > 0.0) bounce_receive(e, rx, rn, i == j, a, xs, cells[s + 1].xyz, power_in[k].rgb, v);
+            if (xs.w > 0.0) bounce_receive(e, rx, rn, i == j, a, xs, cells[s + 1].xyz, power_in[k].rgb * reach[k], v);
         }
         for (int b = 0; b < BOUNCE_FACES; ++b) {
             vec3 p = cells[bounce_face(i, b) + 2].rgb * e[b] * rx[b].w;
@@ -63,7 +64,7 @@ void main() {
             power_out[o] = vec4(p, 0.0);
             vec3 sum = power_sum[o].rgb + p;
             power_sum[o] = vec4(sum, 0.0);
-            total += vec4(p, sum.r + sum.g + sum.b);
+            total += vec2(p.r + p.g + p.b, sum.r + sum.g + sum.b);
         }
     }
     if (!BOUNCE_INFINITE) return;
@@ -73,26 +74,5 @@ void main() {
         if (t < stride) totals[t] += totals[t + stride];
     }
     barrier();
-    vec3 now = totals[0].rgb;
-    bool converged = now.r + now.g + now.b <= BOUNCE_CONVERGED * totals[0].a;
-    // The series' tail past the last bounce computed, taken as geometric at
-    // that bounce's ratio to the one before, per channel: sum_{k>=1} r^k P =
-    // P r / (1 - r). Stopping at 1% left a tail of 1% (a room that keeps half
-    // its light per bounce) to 4% (the sphere at rho 0.8) of the series.
-    if (converged) {
-        vec3 r = mix(vec3(0.0), now / max(last.rgb, vec3(1e-30)), greaterThan(last.rgb, vec3(0.0)));
-        vec3 tail = mix(vec3(0.0), r / (1.0 - r), lessThan(r, vec3(0.95)));
-        for (int i = int(t); i < BOUNCE_CELLS; i += 128) {
-            if (cells[BOUNCE_CELL_VEC4S * i].w <= 0.0) continue;
-            for (int b = 0; b < BOUNCE_FACES; ++b) {
-                int o = BOUNCE_FACES * i + b;
-                if (cells[bounce_face(i, b)].w > 0.0) power_sum[o] += vec4(power_out[o].rgb * tail, 0.0);
-            }
-        }
-    }
-    barrier();
-    if (t == 0u) {
-        last = vec4(now, 0.0);
-        if (converged) done = 1u;
-    }
+    if (t == 0u && totals[0].x <= BOUNCE_CONVERGED * totals[0].y) done = 1u;
 }

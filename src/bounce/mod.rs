@@ -12,7 +12,9 @@
 //!    irradiance E at each face's centroid from [`VPLS`] regular VPLs of the
 //!    RSM; a face re-emits rho E A watts.
 //! 2. `bounce-transfer`: the visibility between every two cells (the run's
-//!    visibility), once a frame.
+//!    visibility), once a frame; then `bounce-reach`, in the same timing
+//!    scope: the scale on each face's power that keeps what the faces
+//!    receive of it at most what it sends.
 //! 3. `bounce-propagate`: bounces 2..N-1 among the faces (`inf`: until a
 //!    bounce brings under 1% of the power so far, at most [`INFINITE_CAP`]).
 //! 4. `bounce-gather`: receivers at one pixel in [`STEP`] x [`STEP`] gather
@@ -73,11 +75,15 @@ pub const CELLS: u32 = SIDE * SIDE * SIDE;
 /// Faces per cell: its surface split by facing, one per axis direction
 /// (`shaders/bounce/bounce.glsl`).
 pub const FACES: u32 = 6;
-/// Bytes per cell: a vec4 for the cell and three per face
-/// (`shaders/bounce/bounce.glsl`).
-const CELL_BYTES: u64 = 16 * (1 + 3 * FACES as u64);
+/// vec4s per cell: one for the cell and three per face
+/// (`shaders/bounce/bounce.glsl`, `BOUNCE_CELL_VEC4S`).
+pub const CELL_VEC4S: u32 = 1 + 3 * FACES;
+/// Bytes per cell.
+const CELL_BYTES: u64 = 16 * CELL_VEC4S as u64;
 /// Bytes of a power per face: a vec4 each.
 const POWER_BYTES: u64 = CELLS as u64 * FACES as u64 * 16;
+/// Bytes of the faces' reach (`bounce-reach`): a float each.
+const REACH_BYTES: u64 = CELLS as u64 * FACES as u64 * 4;
 /// Receivers: one pixel per `STEP` x `STEP` block, upsampled.
 pub const STEP: u32 = 4;
 /// The regular VPLs each cell gathers its first bounce from (fewer where
@@ -119,7 +125,13 @@ pub fn memory(s: &RenderSettings) -> u64 {
         true => crate::frame::check::MAX_LIGHT_VIEWS as u64 * HISTORY_BYTES,
         false => 0,
     };
-    cells * CELL_BYTES + 3 * POWER_BYTES + cells * cells * 4 + receivers * 16 + 32 + history
+    cells * CELL_BYTES
+        + 3 * POWER_BYTES
+        + REACH_BYTES
+        + cells * cells * 4
+        + receivers * 16
+        + 16
+        + history
 }
 
 /// Bytes of one light view's kept power with feedback: a vec4 per face.

@@ -1,4 +1,5 @@
-//! The bounce passes (`bounce-cells`, `bounce-transfer`, `bounce-propagate`,
+//! The bounce passes (`bounce-cells`, `bounce-transfer` with `bounce-reach`,
+//! `bounce-propagate`,
 //! `bounce-gather`, `bounce-add`; docs/algorithm.md section 5.9) and their
 //! buffers. Barriers: each pass waits for the previous one's storage writes
 //! (`compute_to_compute`); the first waits for the previous frame's last
@@ -8,7 +9,9 @@
 //! views' kept powers are zeroed once, before the run's first frame reads
 //! them, behind the same barriers.
 
-use super::{feedback, propagations, CELLS, CELL_BYTES, HISTORY_BYTES, POWER_BYTES, STEP, VPLS};
+use super::{
+    feedback, propagations, CELLS, CELL_BYTES, HISTORY_BYTES, POWER_BYTES, REACH_BYTES, STEP, VPLS,
+};
 use crate::bounces::{Bounces, BOUNCES};
 use crate::frame::{FrameContext, Setup};
 use crate::passes::{ComputePass, INDIRECT_COMPUTE};
@@ -26,6 +29,7 @@ use gpu_allocator::MemoryLocation;
 pub struct BouncePass {
     cells: ComputePass,
     transfer: ComputePass,
+    reach: ComputePass,
     propagate: ComputePass,
     gather: ComputePass,
     add: ComputePass,
@@ -75,9 +79,10 @@ impl BouncePass {
         let power_b = storage(gpu, "power (next)", POWER_BYTES)?;
         let power_sum = storage(gpu, "power summed", POWER_BYTES)?;
         let transfer = storage(gpu, "visibility", cells_n * cells_n * 4)?;
+        let reach = storage(gpu, "reach", REACH_BYTES)?;
         let low = (s.width.div_ceil(STEP), s.height.div_ceil(STEP));
         let received = storage(gpu, "receivers", low.0 as u64 * low.1 as u64 * 16)?;
-        let state = storage(gpu, "state", 32)?;
+        let state = storage(gpu, "state", 16)?;
         // Every shader includes bounce/bounce.glsl, which declares it.
         let step = Spec::int("BOUNCE_STEP", STEP as i32);
         let vis = [&visibility::specialization(s)[..], &[step]].concat();
@@ -112,6 +117,18 @@ impl BouncePass {
             0,
             &vis,
         )?;
+        let reach_pass = ComputePass::new(
+            setup,
+            "bounce-reach",
+            "bounce/reach.comp",
+            &[vec![
+                Binding::storage("BounceCells", &cells),
+                Binding::storage("BounceTransfer", &transfer),
+                Binding::storage("BounceReach", &reach),
+            ]],
+            0,
+            &vis,
+        )?;
         let ping_pong = |from, to| {
             vec![
                 Binding::storage("BounceCells", &cells),
@@ -120,6 +137,7 @@ impl BouncePass {
                 Binding::storage("PowerOut", to),
                 Binding::storage("BouncePowerSum", &power_sum),
                 Binding::storage("BounceState", &state),
+                Binding::storage("BounceReach", &reach),
             ]
         };
         let propagate = ComputePass::new(
@@ -162,6 +180,7 @@ impl BouncePass {
                             Binding::storage("BounceTransfer", &transfer),
                             Binding::storage("BouncePowerSum", &power_sum),
                             Binding::storage("BounceHistory", h),
+                            Binding::storage("BounceReach", &reach),
                         ]
                     })
                     .collect();
@@ -213,6 +232,7 @@ impl BouncePass {
         Ok(Some(Self {
             cells: cells_pass,
             transfer: transfer_pass,
+            reach: reach_pass,
             propagate,
             gather,
             add,
@@ -221,7 +241,9 @@ impl BouncePass {
             extent: (s.width, s.height),
             state,
             feedback,
-            _buffers: vec![cells, power_a, power_b, power_sum, transfer, received],
+            _buffers: vec![
+                cells, power_a, power_b, power_sum, transfer, reach, received,
+            ],
         }))
     }
 
@@ -280,6 +302,9 @@ impl BouncePass {
         profiler.pass(gpu, cmd, "bounce-transfer", INDIRECT_COMPUTE, || {
             self.transfer
                 .dispatch_groups(ctx, 0, &[], (CELLS / 8, CELLS / 8));
+            barrier::compute_to_compute(gpu, cmd);
+            // The faces' reach, from the visibility just written.
+            self.reach.dispatch_groups(ctx, 0, &[], (CELLS / 64, 1));
             barrier::compute_to_compute(gpu, cmd);
         });
         if let Some(f) = &self.feedback {
