@@ -114,10 +114,10 @@ pub const BOUNCES: Param<Bounces> = Param {
            roulette). --method pathtrace reads it, the truth of isr bench, and every gathering \
            method (bounces 2..N through the voxel grid's cells; inf: until a bounce adds under \
            1%)",
-    // Three: the cheapest setting within 1.25x of the lowest error against
-    // the truth of every bounce (docs/results.md, "Bounces"; a test holds
-    // it to the published run).
-    default: DefaultValue::Fixed(Bounces::Count(3)),
+    // Every bounce: the cheapest setting within 1.25x of the lowest error
+    // against the truth of every bounce (docs/results.md, "Bounces"; a test
+    // holds it to the published run).
+    default: DefaultValue::Fixed(Bounces::Infinite),
     range: Range::closed(1.0, MAX_COUNT as f64),
 };
 
@@ -137,8 +137,7 @@ mod tests {
             assert_eq!(Bounces::from_value(b.to_value()), Some(b));
         }
         let mut s = RenderSettings::DEFAULT;
-        assert_eq!(BOUNCES.get(&s), Bounces::Count(3));
-        BOUNCES.set(&mut s, Bounces::Infinite);
+        assert_eq!(BOUNCES.get(&s), Bounces::Infinite);
         assert!(BOUNCES.check(&s).is_ok());
         assert_eq!(BOUNCES.text_in(&s), "inf");
         for bad in [0, MAX_COUNT + 1] {
