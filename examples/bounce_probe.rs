@@ -7,7 +7,12 @@
 //! compared pixels and split by the receiver's facing (floor, ceiling,
 //! walls).
 //!
-//!     cargo run --release --example bounce_probe -- [--scenes a,b] [--method M] [--frame K] [--out-dir DIR]
+//!     cargo run --release --example bounce_probe -- [--scenes a,b] [--method M] [--frame K]
+//!         [--out-dir DIR] [--grid N] [--no-visibility]
+//!
+//! Defaults: `cornell`, `rsm-gather`, frame 3 (the axis's), `out/bench`, the
+//! default grid, with the grid's visibility. Half a minute a scene on 2
+//! cores. The method's own first bounce is printed beside (`b1`).
 
 use anyhow::{bail, Context as _, Result};
 use isr::bench::truth::{truth_mask, ShadowMaps};
@@ -58,7 +63,10 @@ fn main() -> Result<()> {
             "--out-dir" => out_dir = value()?.into(),
             "--no-visibility" => novis = true,
             "--grid" => grid = Some(value()?.parse::<u32>()?),
-            other => bail!("unknown argument {other}"),
+            other => bail!(
+                "unknown argument {other}; takes --scenes a,b, --method M, --frame K, \
+                 --out-dir DIR, --grid N, --no-visibility"
+            ),
         }
     }
     let gpu = Gpu::new(&GpuOptions::default())?;
@@ -68,7 +76,6 @@ fn main() -> Result<()> {
             .find(|s| s.name == name)
             .context("scene")?;
         let scene = isr::bench::scenes::build(name)?;
-        let time = spec.start + frame as f32 / spec.fps;
         let path = out_dir.join(format!("truth/{name}/frame-{frame}-bounces-inf.exr"));
         let image = exr::prelude::read_all_flat_layers_from_file(&path)
             .with_context(|| format!("{}", path.display()))?;
@@ -91,7 +98,7 @@ fn main() -> Result<()> {
                 width: 128,
                 height: 128,
                 rsm_resolution: 128,
-                method: Method::new(Box::leak(method.clone().into_boxed_str())),
+                method: Method::new(isr::methods::by_name(&method)?.key().name()),
                 ..RenderSettings::DEFAULT
             };
             if let Some(side) = grid {
@@ -116,7 +123,6 @@ fn main() -> Result<()> {
             }
             imgs.push(out.indirect);
         }
-        let _ = time;
         let g = g.unwrap();
         // Classes by the receiver's normal.
         let class = |k: usize| {
@@ -143,6 +149,9 @@ fn main() -> Result<()> {
         for c in [None, Some(0), Some(1), Some(2)] {
             let label = c.map_or("all", |c| names[c]);
             let t1 = sum(&t[0], c);
+            if t1 == 0.0 {
+                continue; // no compared pixel faces this way
+            }
             let i = imgs.iter().map(|x| sum(x, c)).collect::<Vec<_>>();
             let tl = t.iter().map(|x| sum(x, c)).collect::<Vec<_>>();
             println!(
