@@ -8,7 +8,7 @@
 //! walls).
 //!
 //!     cargo run --release --example bounce_probe -- [--scenes a,b] [--method M] [--frame K]
-//!         [--out-dir DIR] [--grid N] [--no-visibility]
+//!         [--out-dir DIR] [--grid N] [--no-visibility] [--flicker K]
 //!
 //! Defaults: `cornell`, `rsm-gather`, frame 3 (the axis's), `out/bench`, the
 //! default grid, with the grid's visibility. Half a minute a scene on 2
@@ -46,6 +46,66 @@ fn layer(image: &exr::prelude::FlatImage, name: &str, n: usize) -> Option<Vec<[f
     Some((0..n).map(|k| [r[k], g[k], b[k], 1.0]).collect())
 }
 
+/// `--flicker K`: the flicker (docs/algorithm.md section 6.3, low-passed
+/// first and second differences) of `method` with one bounce against the
+/// truth of one bounce, and with every bounce against the truth of every
+/// bounce, over frames 0..K of `name` (the bench's cached truth of every
+/// bounce at each frame, whose first layer is the truth of one). The
+/// bench's own flicker is against the dense reference, which renders the
+/// same bounce passes: there the bounce light cancels.
+fn flicker(
+    gpu: &Gpu,
+    name: &str,
+    method: &str,
+    out_dir: &std::path::Path,
+    frames: u32,
+) -> Result<()> {
+    use isr::bench::metrics::{geometry_mask, Flicker};
+    let spec = isr::bench::scenes::SCENES
+        .iter()
+        .find(|s| s.name == name)
+        .context("scene")?;
+    let scene = isr::bench::scenes::build(name)?;
+    let n = 128 * 128;
+    let mut rows = vec![];
+    for b in [Bounces::ONE, Bounces::Infinite] {
+        let mut s = RenderSettings {
+            width: 128,
+            height: 128,
+            rsm_resolution: 128,
+            method: Method::new(isr::methods::by_name(method)?.key().name()),
+            ..RenderSettings::DEFAULT
+        };
+        BOUNCES.set(&mut s, b);
+        let mut r = Renderer::new(gpu, &scene, &s)?;
+        let mut f = Flicker::new(128, 128);
+        for k in 0..frames {
+            r.update(&scene.pose_at(spec.start + k as f32 / spec.fps)?)?;
+            r.render_frames(1, |_| {})?;
+            let out = r.readback()?;
+            let path = out_dir.join(format!("truth/{name}/frame-{k}-bounces-inf.exr"));
+            let image = exr::prelude::read_all_flat_layers_from_file(&path)
+                .with_context(|| format!("{}", path.display()))?;
+            let truth = match b {
+                Bounces::ONE => layer(&image, LAYERS[0], n),
+                _ => layer(&image, "indirect", n),
+            }
+            .context("truth layer")?;
+            f.add(&out.indirect, &truth, &geometry_mask(&out.position))?;
+        }
+        rows.push((b, f.flicker(), f.second_difference()));
+    }
+    for (b, first, second) in rows {
+        println!(
+            "{name} ({method}, {frames} frames): {} against the truth of as many: flicker {:.5}, second difference {:.5}",
+            b.words(),
+            first.unwrap_or(f64::NAN),
+            second.unwrap_or(f64::NAN)
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     let mut scenes = vec!["cornell".to_string()];
     let mut method = "rsm-gather".to_string();
@@ -53,6 +113,7 @@ fn main() -> Result<()> {
     let mut out_dir = PathBuf::from("out/bench");
     let mut grid = None;
     let mut novis = false;
+    let mut flicker_frames = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || args.next().with_context(|| format!("{a} takes a value"));
@@ -62,14 +123,21 @@ fn main() -> Result<()> {
             "--frame" => frame = value()?.parse()?,
             "--out-dir" => out_dir = value()?.into(),
             "--no-visibility" => novis = true,
+            "--flicker" => flicker_frames = Some(value()?.parse::<u32>()?),
             "--grid" => grid = Some(value()?.parse::<u32>()?),
             other => bail!(
                 "unknown argument {other}; takes --scenes a,b, --method M, --frame K, \
-                 --out-dir DIR, --grid N, --no-visibility"
+                 --out-dir DIR, --grid N, --no-visibility, --flicker K"
             ),
         }
     }
     let gpu = Gpu::new(&GpuOptions::default())?;
+    if let Some(k) = flicker_frames {
+        for name in &scenes {
+            flicker(&gpu, name, &method, &out_dir, k)?;
+        }
+        return Ok(());
+    }
     for name in &scenes {
         let spec = isr::bench::scenes::SCENES
             .iter()
