@@ -63,22 +63,4 @@ void bounce_receive(inout vec3 e[BOUNCE_FACES], vec4 rx[BOUNCE_FACES], vec3 rn[B
 }
 #endif
 
-// The fraction of the segment x -> y (x inside coarse cell c) at which it
-// leaves c's box. The march between two cells' centroids skips the part
-// inside each cell: a cell's centroid lies off the surfaces it merges (in a
-// stair, inside a step; in a corner, between its walls), by up to half the
-// cell, and a march from it was shadowed by the cell's own surfaces.
-// Occluders inside the two cells are not seen (docs/algorithm.md section
-// 5.9).
-float bounce_cell_leave(vec3 x, vec3 y, int c) {
-    vec4 g = u.grid_cube;
-    float per = float(run.grid_side / BOUNCE_SIDE);  // finest cells per coarse side
-    vec3 lo = vec3(c % BOUNCE_SIDE, (c / BOUNCE_SIDE) % BOUNCE_SIDE, c / (BOUNCE_SIDE * BOUNCE_SIDE)) * per;
-    vec3 a = (x - g.xyz) / g.w;
-    vec3 d = (y - x) / g.w;
-    vec3 ds = mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
-    vec3 tout = max((lo - a) / ds, (lo + per - a) / ds);
-    return min(tout.x, min(tout.y, tout.z));
-}
-
 #endif

@@ -1,9 +1,9 @@
 #version 460
 // Pass `bounce-transfer` (docs/algorithm.md section 5.9): one invocation per
-// pair of coarse cells (i receives, j sends): the visibility V_ij between
-// their centroids with the methods' visibility (vpl.glsl), marched outside
-// both cells' boxes (bounce.glsl, bounce_cell_leave), kept for every later
-// bounce of the frame; the faces' kernels are evaluated where the light is
+// pair of coarse cells (i receives, j sends): the visibility V_ij with the
+// methods' visibility (vpl.glsl), marched between the two cells' largest
+// faces with both ends skipped like a patch's, kept for every later bounce
+// of the frame; the faces' kernels are evaluated where the light is
 // propagated (bounce-propagate). A cell's faces see each other unoccluded.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
