@@ -15,36 +15,12 @@
 //! cores. The method's own first bounce is printed beside (`b1`).
 
 use anyhow::{bail, Context as _, Result};
-use isr::bench::truth::{truth_mask, ShadowMaps};
+use isr::bench::truth::{exr_layer as layer, truth_mask, ShadowMaps};
 use isr::bounces::{Bounces, BOUNCES, LAYERS};
 use isr::renderer::Renderer;
 use isr::settings::{Method, RenderSettings};
 use isr::vk::{Gpu, GpuOptions};
 use std::path::PathBuf;
-
-fn layer(image: &exr::prelude::FlatImage, name: &str, n: usize) -> Option<Vec<[f32; 4]>> {
-    use exr::prelude::FlatSamples;
-    let l = image.layer_data.iter().find(|l| {
-        l.attributes
-            .layer_name
-            .as_ref()
-            .map(|s| s.to_string())
-            .as_deref()
-            == Some(name)
-    })?;
-    let ch = |c: &str| {
-        l.channel_data
-            .list
-            .iter()
-            .find(|ch| ch.name.to_string() == c)
-            .and_then(|ch| match &ch.sample_data {
-                FlatSamples::F32(v) if v.len() == n => Some(v.clone()),
-                _ => None,
-            })
-    };
-    let (r, g, b) = (ch("R")?, ch("G")?, ch("B")?);
-    Some((0..n).map(|k| [r[k], g[k], b[k], 1.0]).collect())
-}
 
 /// `--flicker K`: the flicker (docs/algorithm.md section 6.3, low-passed
 /// first and second differences) of `method` with one bounce against the

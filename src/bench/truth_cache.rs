@@ -4,7 +4,7 @@
 //! bounces, and `exact-K.exr`, each with a JSON note) so that a run that
 //! stops resumes without tracing them again.
 
-use super::truth::{self, trace, truth_mask, ShadowMaps, Truth};
+use super::truth::{self, exr_layer, trace, truth_mask, ShadowMaps, Truth};
 use super::{frame_time, Plan, SceneSpec};
 use crate::bounces::Bounces;
 use crate::readback::Readback;
@@ -132,32 +132,6 @@ fn one_bounce() -> String {
     Bounces::ONE.text()
 }
 
-/// The layer `name` of the EXR `image` as RGBA pixels (alpha 1).
-fn layer(image: &exr::prelude::FlatImage, name: &str, pixels: usize) -> Option<Vec<[f32; 4]>> {
-    use exr::prelude::FlatSamples;
-    let layer = image.layer_data.iter().find(|l| {
-        l.attributes
-            .layer_name
-            .as_ref()
-            .map(|n| n.to_string())
-            .as_deref()
-            == Some(name)
-    })?;
-    let channel = |c: &str| {
-        layer
-            .channel_data
-            .list
-            .iter()
-            .find(|ch| ch.name.to_string() == c)
-            .and_then(|ch| match &ch.sample_data {
-                FlatSamples::F32(v) if v.len() == pixels => Some(v.clone()),
-                _ => None,
-            })
-    };
-    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
-    Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
-}
-
 /// A truth traced before for this frame (`path` and its note), if its size,
 /// time and bounces match and it was traced for this noise target or
 /// measured under it; anything else is traced again. The bounces must
@@ -179,12 +153,12 @@ fn cached(path: &Path, g: &Readback, key: &FrameKey) -> Option<(Readback, u32, f
     let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
     let n = (g.width * g.height) as usize;
     let mut r = g.clone();
-    r.direct = layer(&image, "direct", n)?;
-    r.indirect = layer(&image, "indirect", n)?;
-    r.final_radiance = layer(&image, "final", n)?;
+    r.direct = exr_layer(&image, "direct", n)?;
+    r.indirect = exr_layer(&image, "indirect", n)?;
+    r.final_radiance = exr_layer(&image, "final", n)?;
     let by_bounce: Option<Vec<_>> = crate::bounces::LAYERS[..key.bounces.layers()]
         .iter()
-        .map(|name| layer(&image, name, n))
+        .map(|name| exr_layer(&image, name, n))
         .collect();
     r.bounces = match by_bounce {
         Some(layers) => layers,
@@ -277,7 +251,7 @@ fn cached_exact(path: &Path, g: &Readback, time: f32, rsm: u32) -> Option<Vec<[f
         return None;
     }
     let image = exr::prelude::read_all_flat_layers_from_file(path).ok()?;
-    layer(&image, "indirect", (g.width * g.height) as usize)
+    exr_layer(&image, "indirect", (g.width * g.height) as usize)
 }
 
 /// Writes an exact-visibility reference frame for [`cached_exact`].
