@@ -15,7 +15,8 @@
 //! cores. The method's own first bounce is printed beside (`b1`).
 
 use anyhow::{bail, Context as _, Result};
-use isr::bench::truth::{exr_layer as layer, truth_mask, ShadowMaps};
+use isr::bench::files::exr_layer as layer;
+use isr::bench::truth::{truth_mask, ShadowMaps};
 use isr::bounces::{Bounces, BOUNCES, LAYERS};
 use isr::renderer::Renderer;
 use isr::settings::{Method, RenderSettings};

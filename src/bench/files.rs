@@ -1,7 +1,7 @@
 //! The names of what a bench run writes into its folder, spelled once: the
 //! writers, the checks before a run, the messages and the tests all read
 //! them here, so that a renamed or added output cannot leave one of them
-//! behind.
+//! behind; and the one reader of a cached truth's EXR layers.
 
 use std::path::{Path, PathBuf};
 
@@ -95,6 +95,37 @@ pub fn image(method: &str, suffix: &str) -> String {
 /// The FLIP map beside [`image`]: `hisr-error.png`, `hisr-voxels-error.png`.
 pub fn error_map(method: &str, suffix: &str) -> String {
     format!("{method}{suffix}-error.png")
+}
+
+/// The layer `name` of the EXR `image` as RGBA pixels (alpha 1): how the
+/// truth cache and the bounce examples read a truth back.
+pub fn exr_layer(
+    image: &exr::prelude::FlatImage,
+    name: &str,
+    pixels: usize,
+) -> Option<Vec<[f32; 4]>> {
+    use exr::prelude::FlatSamples;
+    let layer = image.layer_data.iter().find(|l| {
+        l.attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string())
+            .as_deref()
+            == Some(name)
+    })?;
+    let channel = |c: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.to_string() == c)
+            .and_then(|ch| match &ch.sample_data {
+                FlatSamples::F32(v) if v.len() == pixels => Some(v.clone()),
+                _ => None,
+            })
+    };
+    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    Some((0..pixels).map(|k| [r[k], g[k], b[k], 1.0]).collect())
 }
 
 #[cfg(test)]

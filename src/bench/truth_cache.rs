@@ -4,7 +4,8 @@
 //! bounces, and `exact-K.exr`, each with a JSON note) so that a run that
 //! stops resumes without tracing them again.
 
-use super::truth::{self, exr_layer, trace, truth_mask, ShadowMaps, Truth};
+use super::files::exr_layer;
+use super::truth::{self, trace, truth_mask, ShadowMaps, Truth};
 use super::{frame_time, Plan, SceneSpec};
 use crate::bounces::Bounces;
 use crate::readback::Readback;
